@@ -1,0 +1,95 @@
+# libcyl -- top-level build. The two commands a user needs:
+#   make demo    the main job, on built-in data
+#   make test    the whole test suite (what CI runs)
+# Everything installs what it needs first (Debian packages via apt-get, once).
+# Other targets: bench, cross (Cortex-M4 build of libcyl), install PREFIX=..., clean.
+
+SHELL   := /bin/bash
+BUILD   := build
+HOSTLIB := libcyl/build/host
+LIBCYL_A := $(HOSTLIB)/libcyl.a
+CC      ?= cc
+CXX     ?= c++
+# Host build of the core: what CI enforces (the libcyl Makefile adds -std=c99 -Wall -Wextra -Wpedantic).
+CORE_CFLAGS := -O2 -g -Werror
+TEST_CFLAGS := -std=c99 -O2 -g -Wall -Wextra -Ilibcyl/include -Itests/common
+CXXFLAGS_ALL := -std=c++17 -O2 -g -Wall -Wextra -Ilibcyl/include -Itests/common -Ifrontend/include
+
+DEBS_BUILD := build-essential pkg-config libcmocka-dev
+DEBS_CROSS := gcc-arm-none-eabi libnewlib-arm-none-eabi
+DEBS_CV    := libopencv-dev
+DEBS_BENCH := valgrind
+
+STAMP := $(BUILD)/.stamps
+deps-build := $(STAMP)/debs-build
+$(STAMP):
+	mkdir -p $@
+$(STAMP)/debs-%: scripts/ensure-debs.sh | $(STAMP)
+	@scripts/ensure-debs.sh $(DEBS_$(shell echo $* | tr a-z A-Z)) && touch $@
+
+.PHONY: all lib test unit-tests cross demo bench install clean deps
+all: lib
+
+# Feature fragments (one file per feature area) add their own targets and may
+# append to TEST_EXTRA (prerequisites of `make test`) and TEST_EXTRA_BINS (test
+# programs run by scripts/run-tests.sh: cmocka, GoogleTest or pytest output).
+TEST_EXTRA :=
+TEST_EXTRA_BINS :=
+include $(sort $(wildcard mk/*.mk))
+
+deps: $(STAMP)/debs-build $(STAMP)/debs-cross $(STAMP)/debs-cv $(STAMP)/debs-bench
+
+# ---- the core -------------------------------------------------------------
+lib: $(STAMP)/debs-build
+	$(MAKE) -C libcyl BUILD=build/host CFLAGS='$(CORE_CFLAGS)'
+
+$(LIBCYL_A): lib
+
+# Cortex-M4 firmware build: must compile cleanly with the same sources.
+cross: $(STAMP)/debs-cross
+	$(MAKE) -C libcyl BUILD=build/m4 CC=arm-none-eabi-gcc AR=arm-none-eabi-ar \
+	  CFLAGS='-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -Os -Werror'
+	@bad=$$(arm-none-eabi-nm -u libcyl/build/m4/libcyl.a | awk '{print $$2}' | \
+	  grep -E '^(malloc|calloc|realloc|free|printf|fprintf|sprintf|puts|fopen|fwrite|exit|abort)$$' | sort -u); \
+	  if [ -n "$$bad" ]; then echo "cross: libcyl.a references $$bad"; exit 1; fi
+	@arm-none-eabi-size -t libcyl/build/m4/libcyl.a | tail -1 | \
+	  awk '{printf "cross: Cortex-M4 libcyl.a text %d B, data %d B, bss %d B; no heap or stdio symbols\n", $$1, $$2, $$3}'
+
+install: lib
+	$(MAKE) -C libcyl BUILD=build/host install PREFIX=$(or $(PREFIX),/usr/local)
+
+# ---- tests ------------------------------------------------------------------
+TEST_COMMON_SRCS := $(wildcard tests/common/*.c)
+UNIT_SRCS := $(sort $(wildcard tests/unit/test_*.c))
+UNIT_BINS := $(UNIT_SRCS:tests/unit/%.c=$(BUILD)/tests/%)
+
+$(BUILD)/tests/%: tests/unit/%.c $(TEST_COMMON_SRCS) $(wildcard tests/common/*.h) lib
+	@mkdir -p $(dir $@)
+	$(CC) $(TEST_CFLAGS) $< $(TEST_COMMON_SRCS) -o $@ $(LIBCYL_A) -lcmocka -lm
+
+unit-tests: $(UNIT_BINS)
+
+test: $(STAMP)/debs-build $(STAMP)/debs-cv unit-tests cross $(TEST_EXTRA)
+	@scripts/run-tests.sh $(UNIT_BINS) $(TEST_EXTRA_BINS)
+
+# ---- demo -----------------------------------------------------------------
+$(BUILD)/segment_demo: libcyl/examples/segment_demo.c lib
+	@mkdir -p $(dir $@)
+	$(CC) -std=c99 -O2 -Wall -Wextra -Ilibcyl/include $< -o $@ $(LIBCYL_A) -lm
+
+demo: $(BUILD)/segment_demo
+	$(BUILD)/segment_demo
+
+# ---- benchmark ------------------------------------------------------------
+BENCH_C := tests/common/synth_frames.c tests/common/rng.c
+$(BUILD)/bench_segment: bench/bench_segment.cpp $(BENCH_C) lib $(STAMP)/debs-cv
+	@mkdir -p $(BUILD)/bench
+	for f in $(BENCH_C); do $(CC) $(TEST_CFLAGS) -O3 -c $$f -o $(BUILD)/bench/$$(basename $$f .c).o || exit 1; done
+	$(CXX) $(CXXFLAGS_ALL) -O3 $< $(BENCH_C:tests/common/%.c=$(BUILD)/bench/%.o) -o $@ $(LIBCYL_A) \
+	  $$(pkg-config --cflags --libs opencv4) -lm
+
+bench: $(BUILD)/bench_segment $(STAMP)/debs-bench
+	scripts/bench.sh
+
+clean:
+	rm -rf $(BUILD) libcyl/build

@@ -1,0 +1,134 @@
+/* libcyl -- run-length encoding and blobs (paper section 3.2, CMVision-style).
+ *
+ * cyl_segment() does, in one pass over the frame: classification through a
+ * cyl_colortable, run-length encoding per row (runs shorter than min_run_px
+ * samples are dropped -- the paper's binary opening), 4-connected union-find
+ * over runs of the same class into blobs, per-blob statistics, merging of
+ * nearby blobs of the same class, and sorting (by class, then area).
+ *
+ * Sampling: with a region of interest and steps, the frame is read on the
+ * grid of sample points (roi.x + i * x_step, roi.y + j * y_step). Runs and
+ * blobs are expressed in full-image pixel coordinates of those samples; areas
+ * count samples. With the defaults (whole frame, steps 1) grid and image are
+ * the same.
+ *
+ * Memory: the caller passes one block; cyl_segment_mem_size() says how large.
+ * Nothing is allocated and no state is kept between calls other than what the
+ * caller holds in cyl_segmentation.
+ */
+#ifndef CYL_SEGMENT_H
+#define CYL_SEGMENT_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "cyl/status.h"
+#include "cyl/image.h"
+#include "cyl/colortable.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define CYL_NONE 0xFFFFFFFFu   /* "no index" in run and blob links */
+
+/* One horizontal run of samples of one class. */
+typedef struct cyl_run {
+    uint16_t x;       /* image column of the first sample, px */
+    uint16_t y;       /* image row, px */
+    uint16_t width;   /* number of samples; they lie at columns x + k * x_step, k < width */
+    uint8_t cls;      /* class index, 0..CYL_MAX_CLASSES-1 */
+    uint8_t reserved; /* 0 */
+    uint32_t blob;    /* index of the run's blob in cyl_segmentation.blobs, CYL_NONE if dropped */
+    uint32_t next;    /* next run of the same blob in (y, x) order, CYL_NONE at the end */
+} cyl_run;
+
+/* Blob flags. */
+#define CYL_BLOB_TOUCH_LEFT   0x01u  /* has a sample in the first sampled column of the ROI */
+#define CYL_BLOB_TOUCH_RIGHT  0x02u  /* ... in the last sampled column */
+#define CYL_BLOB_TOUCH_TOP    0x04u  /* ... in the first sampled row */
+#define CYL_BLOB_TOUCH_BOTTOM 0x08u  /* ... in the last sampled row */
+#define CYL_BLOB_TOUCH_ANY    0x0Fu
+#define CYL_BLOB_MERGED       0x10u  /* made of more than one 4-connected component */
+
+/* One blob: 4-connected runs of one class, possibly merged with nearby ones. */
+typedef struct cyl_blob {
+    uint8_t cls;              /* class index */
+    uint8_t flags;            /* CYL_BLOB_* bits */
+    uint16_t n_components;    /* 4-connected components merged into it (1 = not merged) */
+    uint16_t x0, y0;          /* bounding box, first column and row, px (inclusive) */
+    uint16_t x1, y1;          /* bounding box, last column and row, px (inclusive) */
+    uint32_t area;            /* samples in the blob (= px with steps 1) */
+    uint32_t first_run;       /* index of its first run in cyl_segmentation.runs; follow cyl_run.next */
+    uint32_t n_runs;          /* number of runs */
+    double cx_px;             /* centroid column, px */
+    double cy_px;             /* centroid row, px */
+    double mxx_px2;           /* central second moment E[(x-cx)^2], px^2 */
+    double myy_px2;           /* central second moment E[(y-cy)^2], px^2 */
+    double mxy_px2;           /* central second moment E[(x-cx)(y-cy)], px^2 */
+    double orientation_rad;   /* major axis angle from +x (right) towards +y (down), (-pi/2, pi/2] */
+    double elongation;        /* 1 - minor/major axis length ratio, 0 (round or square) .. 1 (a line) */
+} cyl_blob;
+
+/* Per-class blob rules. */
+typedef struct cyl_class_params {
+    uint32_t min_area;        /* blobs with fewer samples are dropped, after merging (default 9) */
+    int32_t merge_gap_px;     /* merge two blobs of the class when their boxes are at most this many
+                                 px apart along x and along y (gap 0 = boxes touch); < 0 disables (default 3) */
+    double merge_min_density; /* ... and the merged area / merged bounding-box area (in samples) is at
+                                 least this, 0..1 (default 0.5) */
+} cyl_class_params;
+
+typedef struct cyl_segment_params {
+    uint16_t min_run_px;      /* runs shorter than this many samples are dropped (default 3; 1 keeps all) */
+    uint16_t x_step;          /* sample every x_step-th column (default 1) */
+    uint16_t y_step;          /* sample every y_step-th row (default 1) */
+    cyl_roi roi;              /* region of interest (default all zero = whole frame) */
+    cyl_class_params cls[CYL_MAX_CLASSES]; /* per-class rules */
+} cyl_segment_params;
+
+/* Defaults described above. */
+cyl_segment_params cyl_segment_params_default(void);
+
+/* Result of cyl_segment(). Set up with cyl_segmentation_init(); reused frame after frame. */
+typedef struct cyl_segmentation {
+    cyl_run *runs;            /* kept runs, in (y, x) order */
+    uint32_t n_runs;          /* runs in use */
+    uint32_t max_runs;        /* capacity */
+    cyl_blob *blobs;          /* blobs sorted by class (ascending), then area (descending),
+                                 then y0, x0 */
+    uint32_t n_blobs;         /* blobs in use */
+    uint32_t max_blobs;       /* capacity */
+    uint32_t class_first[CYL_MAX_CLASSES]; /* index of the first blob of each class */
+    uint32_t class_count[CYL_MAX_CLASSES]; /* number of blobs of each class */
+    uint32_t x_origin, y_origin; /* first sample of the grid (the ROI's corner), px */
+    uint32_t x_last, y_last;  /* last sampled column and row, px */
+    uint16_t x_step, y_step;  /* grid steps used */
+    uint32_t frame_width, frame_height; /* size of the frame segmented, px */
+    uint32_t truncated;       /* 0, or CYL_SEG_RUNS_FULL | CYL_SEG_BLOBS_FULL */
+    void *work;               /* internal workspace (inside the caller's block) */
+    size_t work_size;
+} cyl_segmentation;
+
+#define CYL_SEG_RUNS_FULL  0x1u  /* more runs than max_runs: rows after the overflow were not encoded */
+#define CYL_SEG_BLOBS_FULL 0x2u  /* more components than max_blobs: the later ones were dropped */
+
+/* Worst-case run count of a frame (every row full of minimum-length runs). */
+uint32_t cyl_segment_max_runs(uint32_t width, uint32_t height, const cyl_segment_params *p);
+
+/* Bytes of memory cyl_segmentation_init() needs for these capacities (0 on overflow). */
+size_t cyl_segment_mem_size(uint32_t max_runs, uint32_t max_blobs);
+
+/* Lay out a caller block of mem_size bytes (at least cyl_segment_mem_size(), any alignment). */
+cyl_status cyl_segmentation_init(cyl_segmentation *seg, void *mem, size_t mem_size,
+                                 uint32_t max_runs, uint32_t max_blobs);
+
+/* Segment one frame. Returns CYL_OK, CYL_TRUNCATED (results valid for what fitted; see
+ * seg->truncated), or an error (CYL_ERR_ARG, _FORMAT, _SIZE). Deterministic: the same
+ * frame, table and parameters give bit-identical results. */
+cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
+                       const cyl_segment_params *p, cyl_segmentation *seg);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* CYL_SEGMENT_H */

@@ -1,0 +1,278 @@
+#include "cyl/colortable.h"
+#include "internal.h"
+#include <string.h>
+
+void cyl_colortable_init(cyl_colortable *t)
+{
+    unsigned i;
+    if (!t) return;
+    memset(t, 0, sizeof *t);
+    for (i = 0; i < CYL_MAX_CLASSES; i++) t->rgb[i][0] = t->rgb[i][1] = t->rgb[i][2] = 128;
+}
+
+cyl_status cyl_colortable_set_class(cyl_colortable *t, unsigned cls, const char *name,
+                                    uint8_t r, uint8_t g, uint8_t b)
+{
+    size_t n = 0;
+    if (!t || !name) return CYL_ERR_ARG;
+    if (cls >= CYL_MAX_CLASSES) return CYL_ERR_CLASS;
+    while (n < CYL_CLASS_NAME_LEN - 1u && name[n]) n++;
+    memset(t->name[cls], 0, CYL_CLASS_NAME_LEN);
+    memcpy(t->name[cls], name, n);
+    t->rgb[cls][0] = r; t->rgb[cls][1] = g; t->rgb[cls][2] = b;
+    return CYL_OK;
+}
+
+int cyl_colortable_find_class(const cyl_colortable *t, const char *name)
+{
+    unsigned i;
+    if (!t || !name || !name[0]) return -1;
+    for (i = 0; i < CYL_MAX_CLASSES; i++)
+        if (strncmp(t->name[i], name, CYL_CLASS_NAME_LEN) == 0) return (int)i;
+    return -1;
+}
+
+cyl_status cyl_colortable_clear_class(cyl_colortable *t, unsigned cls)
+{
+    unsigned i, j;
+    cyl_mask keep;
+    if (!t) return CYL_ERR_ARG;
+    if (cls >= CYL_MAX_CLASSES) return CYL_ERR_CLASS;
+    keep = (cyl_mask)~(1u << cls);
+    for (i = 0; i < 256; i++) {
+        t->y[i] &= keep;
+        for (j = 0; j < 256; j++) t->uv[i][j] &= keep;
+    }
+    return CYL_OK;
+}
+
+cyl_status cyl_colortable_add_box(cyl_colortable *t, unsigned cls,
+                                  uint8_t y_lo, uint8_t y_hi,
+                                  uint8_t u_lo, uint8_t u_hi,
+                                  uint8_t v_lo, uint8_t v_hi)
+{
+    unsigned u, v, y;
+    cyl_mask bit;
+    if (!t) return CYL_ERR_ARG;
+    if (cls >= CYL_MAX_CLASSES) return CYL_ERR_CLASS;
+    if (y_lo > y_hi || u_lo > u_hi || v_lo > v_hi) return CYL_ERR_ARG;
+    bit = (cyl_mask)(1u << cls);
+    for (u = u_lo; u <= u_hi; u++)
+        for (v = v_lo; v <= v_hi; v++) t->uv[u][v] |= bit;
+    for (y = y_lo; y <= y_hi; y++) t->y[y] |= bit;
+    return CYL_OK;
+}
+
+unsigned cyl_mask_class(cyl_mask m)
+{
+    unsigned i;
+    if (!m) return CYL_CLASS_NONE;
+    for (i = 0; !(m & (1u << i)); i++) {}
+    return i;
+}
+
+cyl_status cyl_classify(const cyl_colortable *t, const cyl_image *img, const cyl_roi *roi,
+                        unsigned x_step, unsigned y_step, uint8_t *out, size_t out_stride)
+{
+    cyl_roi r;
+    uint32_t x, y, i, j;
+    cyl_status s;
+    if (!t || !out) return CYL_ERR_ARG;
+    s = cyl_image_check(img);
+    if (s != CYL_OK) return s;
+    if (x_step == 0 || y_step == 0) return CYL_ERR_ARG;
+    if (!cyl_roi_resolve(img, roi, &r)) return CYL_ERR_SIZE;
+    if (out_stride < (r.width + x_step - 1u) / x_step) return CYL_ERR_SIZE;
+    for (j = 0, y = r.y; y < r.y + r.height; y += y_step, j++) {
+        uint8_t *o = out + (size_t)j * out_stride;
+        for (i = 0, x = r.x; x < r.x + r.width; x += x_step, i++) {
+            uint8_t Y, U, V;
+            cyl_pixel_fetch(img, x, y, &Y, &U, &V);
+            o[i] = (uint8_t)cyl_mask_class(cyl_colortable_mask(t, Y, U, V));
+        }
+    }
+    return CYL_OK;
+}
+
+/* ---- training ---------------------------------------------------------- */
+
+cyl_train_params cyl_train_params_default(void)
+{
+    cyl_train_params p;
+    p.min_bin_count = 2;
+    p.min_bin_fraction = 0.002;
+    p.uv_margin = 3;
+    p.y_lo_fraction = 0.01;
+    p.y_hi_fraction = 0.99;
+    p.y_margin = 16;
+    return p;
+}
+
+size_t cyl_train_workspace_size(void)
+{
+    return (65536u + 256u) * sizeof(uint32_t);
+}
+
+/* Smallest level whose cumulative count exceeds q * total. */
+static unsigned quantile(const uint32_t *h, uint64_t total, double q)
+{
+    uint64_t acc = 0;
+    double target = q * (double)total;
+    unsigned i;
+    for (i = 0; i < 256; i++) {
+        acc += h[i];
+        if ((double)acc > target) return i;
+    }
+    return 255;
+}
+
+cyl_status cyl_colortable_train(cyl_colortable *t, unsigned cls, const cyl_image *img,
+                                const cyl_roi *region, const cyl_train_params *params,
+                                void *work, size_t work_size, uint8_t box[6])
+{
+    cyl_train_params p = params ? *params : cyl_train_params_default();
+    uint32_t *uvh, *yh;
+    uint32_t x, y, thr;
+    uint64_t n, kept = 0;
+    unsigned u, v, ulo = 255, uhi = 0, vlo = 255, vhi = 0, ylo, yhi, m = p.uv_margin;
+    cyl_roi r;
+    cyl_status s;
+
+    if (!t || !work) return CYL_ERR_ARG;
+    if (cls >= CYL_MAX_CLASSES) return CYL_ERR_CLASS;
+    if (work_size < cyl_train_workspace_size() || ((uintptr_t)work % sizeof(uint32_t)) != 0)
+        return CYL_ERR_NOMEM;
+    if (!(p.min_bin_fraction >= 0.0 && p.min_bin_fraction <= 1.0) ||
+        !(p.y_lo_fraction >= 0.0 && p.y_lo_fraction <= p.y_hi_fraction && p.y_hi_fraction <= 1.0))
+        return CYL_ERR_ARG;
+    s = cyl_image_check(img);
+    if (s != CYL_OK) return s;
+    if (!cyl_roi_resolve(img, region, &r)) return CYL_ERR_SIZE;
+
+    uvh = (uint32_t *)work;
+    yh = uvh + 65536;
+    memset(uvh, 0, cyl_train_workspace_size());
+    for (y = r.y; y < r.y + r.height; y++)
+        for (x = r.x; x < r.x + r.width; x++) {
+            uint8_t Y, U, V;
+            cyl_pixel_fetch(img, x, y, &Y, &U, &V);
+            uvh[(unsigned)U << 8 | V]++;
+        }
+    n = (uint64_t)r.width * r.height;
+    {
+        double f = p.min_bin_fraction * (double)n;
+        thr = (uint32_t)f;
+        if ((double)thr < f) thr++;
+        if (thr < p.min_bin_count) thr = p.min_bin_count;
+        if (thr < 1) thr = 1;
+    }
+    for (u = 0; u < 256; u++)
+        for (v = 0; v < 256; v++)
+            if (uvh[u << 8 | v] >= thr) {
+                if (u < ulo) ulo = u;
+                if (u > uhi) uhi = u;
+                if (v < vlo) vlo = v;
+                if (v > vhi) vhi = v;
+            }
+    if (ulo > uhi) return CYL_ERR_EMPTY;
+    /* Brightness of the pixels whose chrominance survived the threshold. */
+    for (y = r.y; y < r.y + r.height; y++)
+        for (x = r.x; x < r.x + r.width; x++) {
+            uint8_t Y, U, V;
+            cyl_pixel_fetch(img, x, y, &Y, &U, &V);
+            if (uvh[(unsigned)U << 8 | V] >= thr) { yh[Y]++; kept++; }
+        }
+    ylo = quantile(yh, kept, p.y_lo_fraction);
+    yhi = quantile(yh, kept, p.y_hi_fraction);
+    ylo = ylo > p.y_margin ? ylo - p.y_margin : 0u;
+    yhi = yhi + p.y_margin < 255u ? yhi + p.y_margin : 255u;
+    ulo = ulo > m ? ulo - m : 0u;
+    vlo = vlo > m ? vlo - m : 0u;
+    uhi = uhi + m < 255u ? uhi + m : 255u;
+    vhi = vhi + m < 255u ? vhi + m : 255u;
+    if (box) {
+        box[0] = (uint8_t)ulo; box[1] = (uint8_t)uhi; box[2] = (uint8_t)vlo;
+        box[3] = (uint8_t)vhi; box[4] = (uint8_t)ylo; box[5] = (uint8_t)yhi;
+    }
+    return cyl_colortable_add_box(t, cls, (uint8_t)ylo, (uint8_t)yhi, (uint8_t)ulo, (uint8_t)uhi,
+                                  (uint8_t)vlo, (uint8_t)vhi);
+}
+
+/* ---- serialisation ------------------------------------------------------- */
+
+uint32_t cyl_crc32(uint32_t crc, const uint8_t *buf, size_t len)
+{
+    /* Nibble-wise table of the reflected polynomial 0xEDB88320. */
+    static const uint32_t tab[16] = {
+        0x00000000u, 0x1DB71064u, 0x3B6E20C8u, 0x26D930ACu, 0x76DC4190u, 0x6B6B51F4u,
+        0x4DB26158u, 0x5005713Cu, 0xEDB88320u, 0xF00F9344u, 0xD6D6A3E8u, 0xCB61B38Cu,
+        0x9B64C2B0u, 0x86D3D2D4u, 0xA00AE278u, 0xBDBDF21Cu };
+    size_t i;
+    crc = ~crc;
+    for (i = 0; i < len; i++) {
+        crc ^= buf[i];
+        crc = (crc >> 4) ^ tab[crc & 15u];
+        crc = (crc >> 4) ^ tab[crc & 15u];
+    }
+    return ~crc;
+}
+
+#define OFF_CLASSES 8u
+#define CLASS_REC 20u
+#define OFF_Y (OFF_CLASSES + CYL_MAX_CLASSES * CLASS_REC)
+#define OFF_UV (OFF_Y + 256u)
+#define OFF_CRC (OFF_UV + 65536u)
+
+cyl_status cyl_colortable_save(const cyl_colortable *t, uint8_t *buf, size_t cap, size_t *len)
+{
+    unsigned i;
+    if (!t || !buf) return CYL_ERR_ARG;
+    if (cap < CYL_TABLE_FILE_SIZE) return CYL_ERR_NOMEM;
+    memcpy(buf, "CYLT", 4);
+    cyl_put_u16(buf + 4, (uint16_t)CYL_TABLE_FILE_VERSION);
+    buf[6] = CYL_MAX_CLASSES;
+    buf[7] = 0;
+    for (i = 0; i < CYL_MAX_CLASSES; i++) {
+        uint8_t *rec = buf + OFF_CLASSES + i * CLASS_REC;
+        unsigned k;
+        memset(rec, 0, CLASS_REC);
+        for (k = 0; k < CYL_CLASS_NAME_LEN - 1u && t->name[i][k]; k++) rec[k] = (uint8_t)t->name[i][k];
+        memcpy(rec + CYL_CLASS_NAME_LEN, t->rgb[i], 3);
+    }
+    memcpy(buf + OFF_Y, t->y, 256);
+    memcpy(buf + OFF_UV, t->uv, 65536);
+    cyl_put_u32(buf + OFF_CRC, cyl_crc32(0, buf, OFF_CRC));
+    if (len) *len = CYL_TABLE_FILE_SIZE;
+    return CYL_OK;
+}
+
+cyl_status cyl_colortable_load(cyl_colortable *t, const uint8_t *buf, size_t len)
+{
+    unsigned i, k;
+    if (!t || (!buf && len)) return CYL_ERR_ARG;
+    if (len < 4) return CYL_ERR_FILE_TRUNCATED;
+    if (memcmp(buf, "CYLT", 4) != 0) return CYL_ERR_FILE_MAGIC;
+    if (len < 8) return CYL_ERR_FILE_TRUNCATED;
+    if (cyl_get_u16(buf + 4) != CYL_TABLE_FILE_VERSION) return CYL_ERR_FILE_VERSION;
+    if (len < CYL_TABLE_FILE_SIZE) return CYL_ERR_FILE_TRUNCATED;
+    if (cyl_crc32(0, buf, OFF_CRC) != cyl_get_u32(buf + OFF_CRC)) return CYL_ERR_FILE_CHECKSUM;
+    if (len > CYL_TABLE_FILE_SIZE) return CYL_ERR_FILE_CORRUPT;
+    if (buf[6] != CYL_MAX_CLASSES || buf[7] != 0) return CYL_ERR_FILE_CORRUPT;
+    for (i = 0; i < CYL_MAX_CLASSES; i++) {
+        const uint8_t *rec = buf + OFF_CLASSES + i * CLASS_REC;
+        int terminated = 0;
+        for (k = 0; k < CYL_CLASS_NAME_LEN; k++)
+            if (rec[k] == 0) { terminated = 1; break; }
+        if (!terminated || rec[CLASS_REC - 1u] != 0) return CYL_ERR_FILE_CORRUPT;
+        for (; k < CYL_CLASS_NAME_LEN; k++)
+            if (rec[k] != 0) return CYL_ERR_FILE_CORRUPT; /* padding must be zero */
+    }
+    for (i = 0; i < CYL_MAX_CLASSES; i++) {
+        const uint8_t *rec = buf + OFF_CLASSES + i * CLASS_REC;
+        memcpy(t->name[i], rec, CYL_CLASS_NAME_LEN);
+        memcpy(t->rgb[i], rec + CYL_CLASS_NAME_LEN, 3);
+    }
+    memcpy(t->y, buf + OFF_Y, 256);
+    memcpy(t->uv, buf + OFF_UV, 65536);
+    return CYL_OK;
+}

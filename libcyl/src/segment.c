@@ -1,0 +1,544 @@
+/* Run-length encoding, 4-connected union-find over runs, blob statistics,
+ * merging and sorting. See cyl/segment.h for the contract.
+ *
+ * Design notes
+ * - Classification and run-length encoding are fused: no class image is
+ *   written. For the 4:2:2 and 4:2:0 formats with x_step 1, the chroma pair
+ *   of two neighbouring pixels is looked up once; when it maps to no class
+ *   and no run is open, both pixels are skipped without touching Y.
+ * - Runs are stored only for classified pixels (background is implicit).
+ * - Union-find links the larger root to the smaller index, so every run's
+ *   parent index is <= its own and a component's root is its first run in
+ *   (y, x) order; labels therefore come out in raster order of first runs.
+ */
+#include "cyl/segment.h"
+#include "internal.h"
+#include "lowbit.h"
+#include <math.h>
+#include <string.h>
+
+/* Per-blob accumulators (exact integer sums), in the caller's block. */
+typedef struct blob_acc {
+    int64_t n, sx, sy, sxx, syy, sxy;
+    uint32_t last_run;   /* tail of the blob's run list */
+    uint32_t alive;      /* 0 once merged into another blob or dropped */
+} blob_acc;
+
+cyl_segment_params cyl_segment_params_default(void)
+{
+    cyl_segment_params p;
+    unsigned i;
+    memset(&p, 0, sizeof p);
+    p.min_run_px = 3;
+    p.x_step = 1;
+    p.y_step = 1;
+    for (i = 0; i < CYL_MAX_CLASSES; i++) {
+        p.cls[i].min_area = 9;
+        p.cls[i].merge_gap_px = 3;
+        p.cls[i].merge_min_density = 0.5;
+    }
+    return p;
+}
+
+uint32_t cyl_segment_max_runs(uint32_t width, uint32_t height, const cyl_segment_params *p)
+{
+    uint32_t xs = 1, ys = 1, mr = 1, w = width, h = height;
+    uint64_t n;
+    if (p) {
+        xs = p->x_step ? p->x_step : 1u;
+        ys = p->y_step ? p->y_step : 1u;
+        mr = p->min_run_px ? p->min_run_px : 1u;
+        if (p->roi.width && p->roi.height) { w = p->roi.width; h = p->roi.height; }
+    }
+    n = (uint64_t)((w + xs - 1u) / xs / mr) * ((h + ys - 1u) / ys);
+    return n > 0xFFFFFFFEull ? 0xFFFFFFFEu : (uint32_t)n;
+}
+
+#define ALIGN_UP(n, a) (((n) + ((a) - 1u)) & ~(size_t)((a) - 1u))
+
+size_t cyl_segment_mem_size(uint32_t max_runs, uint32_t max_blobs)
+{
+    /* 64-bit arithmetic: the sum cannot wrap, and is checked against size_t (32-bit targets). */
+    uint64_t runs = ((uint64_t)max_runs * sizeof(cyl_run) + 15u) & ~(uint64_t)15u;
+    uint64_t blobs = ((uint64_t)max_blobs * sizeof(cyl_blob) + 15u) & ~(uint64_t)15u;
+    uint64_t accs = ((uint64_t)max_blobs * sizeof(blob_acc) + 15u) & ~(uint64_t)15u;
+    uint64_t total = 16u + runs + blobs + accs;
+    if (max_runs >= CYL_NONE || max_blobs >= CYL_NONE) return 0;
+    if (total > (uint64_t)(((size_t)-1) >> 1)) return 0;
+    return (size_t)total;
+}
+
+cyl_status cyl_segmentation_init(cyl_segmentation *seg, void *mem, size_t mem_size,
+                                 uint32_t max_runs, uint32_t max_blobs)
+{
+    size_t need = cyl_segment_mem_size(max_runs, max_blobs);
+    uint8_t *p;
+    if (!seg || !mem) return CYL_ERR_ARG;
+    if (need == 0 || max_runs == 0 || max_blobs == 0) return CYL_ERR_ARG;
+    if (mem_size < need) return CYL_ERR_NOMEM;
+    memset(seg, 0, sizeof *seg);
+    p = (uint8_t *)cyl_align_ptr(mem, 16u);
+    seg->runs = (cyl_run *)(void *)p;
+    p += ALIGN_UP((size_t)max_runs * sizeof(cyl_run), 16u);
+    seg->blobs = (cyl_blob *)(void *)p;
+    p += ALIGN_UP((size_t)max_blobs * sizeof(cyl_blob), 16u);
+    seg->work = p;
+    seg->work_size = ALIGN_UP((size_t)max_blobs * sizeof(blob_acc), 16u);
+    seg->max_runs = max_runs;
+    seg->max_blobs = max_blobs;
+    return CYL_OK;
+}
+
+/* ---- run-length encoding ------------------------------------------------ */
+
+typedef struct rle_ctx {
+    cyl_run *runs;
+    uint32_t n, max;
+    uint32_t min_run;
+    int full;
+} rle_ctx;
+
+static int emit(rle_ctx *c, uint32_t x, uint32_t y, uint32_t len, unsigned cls)
+{
+    cyl_run *r;
+    if (len < c->min_run) return 1;
+    if (c->n >= c->max) { c->full = 1; return 0; }
+    r = &c->runs[c->n];
+    r->x = (uint16_t)x;
+    r->y = (uint16_t)y;
+    r->width = (uint16_t)len;
+    r->cls = (uint8_t)cls;
+    r->reserved = 0;
+    r->blob = c->n;   /* union-find parent: itself */
+    r->next = CYL_NONE;
+    c->n++;
+    return 1;
+}
+
+/* Advance the run state by one sample of class cls at position pos (sample
+ * index); returns 0 when the run buffer is full. */
+#define STEP(cls_expr, pos)                                                   \
+    do {                                                                      \
+        unsigned c_ = (cls_expr);                                             \
+        if (c_ != cur) {                                                      \
+            if (cur != CYL_CLASS_NONE &&                                      \
+                !emit(ctx, x_img0 + start * xs, y, (pos) - start, cur))       \
+                return 0;                                                     \
+            cur = c_;                                                         \
+            start = (pos);                                                    \
+        }                                                                     \
+    } while (0)
+
+#if defined(__GNUC__)
+#define CYL_HOT_INLINE static inline __attribute__((always_inline))
+#else
+#define CYL_HOT_INLINE static inline
+#endif
+
+/* Samples [x0, x1) of a row of a format whose two horizontal neighbours
+ * (even x, x+1) share chroma. yp: luma row, ysz: bytes per luma sample;
+ * up/vp: chroma of pair 0 (pixel 0), cs: bytes from one chroma pair to the next.
+ * x_step is 1 here, so sample index == image column. Inlined into one copy per
+ * format so that ysz and cs are constants. */
+CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t y,
+                                const uint8_t *yp, const unsigned ysz, const uint8_t *up,
+                                const uint8_t *vp, const unsigned cs, uint32_t x0, uint32_t x1)
+{
+    const cyl_mask (*uv)[256] = t->uv;
+    const cyl_mask *ytab = t->y;
+    unsigned cur = CYL_CLASS_NONE;
+    uint32_t x = x0, start = x0, x_img0 = 0, xs = 1;
+    if (x & 1u) {
+        cyl_mask m = uv[up[(x / 2u) * cs]][vp[(x / 2u) * cs]];
+        STEP(cyl_lowbit[m & ytab[yp[x * ysz]]], x);
+        x++;
+    }
+    while (x + 1u < x1) {
+        cyl_mask m;
+        if (cur == CYL_CLASS_NONE) {
+            /* Background fast path: skip pairs whose chroma is in no class,
+             * two pairs at a time, without reading luma. */
+            const uint8_t *pu = up + (x / 2u) * cs, *pv = vp + (x / 2u) * cs;
+            while (x + 3u < x1 && (uv[pu[0]][pv[0]] | uv[pu[cs]][pv[cs]]) == 0) {
+                x += 4u; pu += 2u * cs; pv += 2u * cs;
+            }
+            if (x + 1u < x1 && uv[pu[0]][pv[0]] == 0) { x += 2u; continue; }
+            if (x + 1u >= x1) break;
+            m = uv[pu[0]][pv[0]];
+        } else {
+            m = uv[up[(x / 2u) * cs]][vp[(x / 2u) * cs]];
+        }
+        STEP(cyl_lowbit[m & ytab[yp[x * ysz]]], x);
+        STEP(cyl_lowbit[m & ytab[yp[(x + 1u) * ysz]]], x + 1u);
+        x += 2u;
+    }
+    if (x < x1) {
+        cyl_mask m = uv[up[(x / 2u) * cs]][vp[(x / 2u) * cs]];
+        STEP(cyl_lowbit[m & ytab[yp[x * ysz]]], x);
+    }
+    if (cur != CYL_CLASS_NONE && !emit(ctx, start, y, x1 - start, cur)) return 0;
+    return 1;
+}
+
+/* One copy per format, with constant layouts. */
+static int encode_yuyv(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r, uint32_t x0, uint32_t x1)
+{
+    return encode_pairs(c, t, y, r, 2u, r + 1, r + 3, 4u, x0, x1);
+}
+static int encode_uyvy(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r, uint32_t x0, uint32_t x1)
+{
+    return encode_pairs(c, t, y, r + 1, 2u, r, r + 2, 4u, x0, x1);
+}
+static int encode_nv12(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r,
+                       const uint8_t *uv, uint32_t x0, uint32_t x1)
+{
+    return encode_pairs(c, t, y, r, 1u, uv, uv + 1, 2u, x0, x1);
+}
+static int encode_i420(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r,
+                       const uint8_t *u, const uint8_t *v, uint32_t x0, uint32_t x1)
+{
+    return encode_pairs(c, t, y, r, 1u, u, v, 1u, x0, x1);
+}
+
+/* Any format and step: one pixel fetch per sample. */
+static int encode_generic(rle_ctx *ctx, const cyl_colortable *t, const cyl_image *img,
+                          uint32_t y, uint32_t x_img0, uint32_t xs, uint32_t n)
+{
+    unsigned cur = CYL_CLASS_NONE;
+    uint32_t i, start = 0;
+    for (i = 0; i < n; i++) {
+        uint8_t Y, U, V;
+        cyl_pixel_fetch(img, x_img0 + i * xs, y, &Y, &U, &V);
+        STEP(cyl_lowbit[t->uv[U][V] & t->y[Y]], i);
+    }
+    if (cur != CYL_CLASS_NONE && !emit(ctx, x_img0 + start * xs, y, n - start, cur)) return 0;
+    return 1;
+}
+#undef STEP
+
+static int encode_row(rle_ctx *ctx, const cyl_colortable *t, const cyl_image *img,
+                      uint32_t y, uint32_t x0, uint32_t xs, uint32_t n)
+{
+    const uint8_t *r0 = img->plane[0] + (size_t)y * img->stride[0];
+    if (xs == 1u) {
+        uint32_t x1 = x0 + n;
+        switch (img->format) {
+        case CYL_FMT_YUYV:
+            return encode_yuyv(ctx, t, y, r0, x0, x1);
+        case CYL_FMT_UYVY:
+            return encode_uyvy(ctx, t, y, r0, x0, x1);
+        case CYL_FMT_NV12:
+            return encode_nv12(ctx, t, y, r0, img->plane[1] + (size_t)(y / 2u) * img->stride[1], x0, x1);
+        case CYL_FMT_I420:
+            return encode_i420(ctx, t, y, r0, img->plane[1] + (size_t)(y / 2u) * img->stride[1],
+                               img->plane[2] + (size_t)(y / 2u) * img->stride[2], x0, x1);
+        default:
+            break;
+        }
+    }
+    return encode_generic(ctx, t, img, y, x0, xs, n);
+}
+
+/* ---- union-find ------------------------------------------------------------ */
+
+static uint32_t uf_find(cyl_run *r, uint32_t i)
+{
+    while (r[i].blob != i) {
+        r[i].blob = r[r[i].blob].blob; /* path halving keeps parent <= index */
+        i = r[i].blob;
+    }
+    return i;
+}
+
+static void uf_union(cyl_run *r, uint32_t a, uint32_t b)
+{
+    a = uf_find(r, a);
+    b = uf_find(r, b);
+    if (a < b) r[b].blob = a;
+    else if (b < a) r[a].blob = b;
+}
+
+/* Join runs of the previous sampled row [pb, pe) with the current one [cb, ce). */
+static void connect_rows(cyl_run *r, uint32_t pb, uint32_t pe, uint32_t cb, uint32_t ce, uint32_t xs)
+{
+    uint32_t i = pb, j = cb;
+    while (i < pe && j < ce) {
+        uint32_t a0 = r[i].x, a1 = a0 + (uint32_t)(r[i].width - 1u) * xs;
+        uint32_t b0 = r[j].x, b1 = b0 + (uint32_t)(r[j].width - 1u) * xs;
+        if (a0 <= b1 && b0 <= a1 && r[i].cls == r[j].cls) uf_union(r, i, j);
+        if (a1 < b1) i++; else j++;
+    }
+}
+
+/* ---- blobs ------------------------------------------------------------------ */
+
+static void acc_add_run(blob_acc *a, const cyl_run *r, uint32_t xs)
+{
+    int64_t w = r->width, x = r->x, y = r->y, s = xs;
+    int64_t s1 = w * (w - 1) / 2;                   /* sum of k, k < w */
+    int64_t s2 = (w - 1) * w * (2 * w - 1) / 6;     /* sum of k^2 */
+    int64_t sumx = w * x + s * s1;
+    a->n += w;
+    a->sx += sumx;
+    a->sy += w * y;
+    a->sxx += w * x * x + 2 * x * s * s1 + s * s * s2;
+    a->syy += w * y * y;
+    a->sxy += y * sumx;
+}
+
+/* Merge two run lists sorted by index into one. */
+static uint32_t merge_lists(cyl_run *r, uint32_t a, uint32_t b, uint32_t *tail)
+{
+    uint32_t head = CYL_NONE, last = CYL_NONE;
+    while (a != CYL_NONE || b != CYL_NONE) {
+        uint32_t take;
+        if (b == CYL_NONE || (a != CYL_NONE && a < b)) { take = a; a = r[a].next; }
+        else { take = b; b = r[b].next; }
+        if (last == CYL_NONE) head = take; else r[last].next = take;
+        last = take;
+    }
+    if (last != CYL_NONE) r[last].next = CYL_NONE;
+    *tail = last;
+    return head;
+}
+
+static uint32_t box_gap(uint32_t a0, uint32_t a1, uint32_t b0, uint32_t b1)
+{
+    if (b0 > a1) return b0 - a1 - 1u;
+    if (a0 > b1) return a0 - b1 - 1u;
+    return 0;
+}
+
+static int try_merge(cyl_segmentation *seg, blob_acc *acc, uint32_t ia, uint32_t ib,
+                     const cyl_class_params *cp)
+{
+    cyl_blob *a = &seg->blobs[ia], *b = &seg->blobs[ib];
+    uint32_t X0, X1, Y0, Y1;
+    double box;
+    if (box_gap(a->x0, a->x1, b->x0, b->x1) > (uint32_t)cp->merge_gap_px) return 0;
+    if (box_gap(a->y0, a->y1, b->y0, b->y1) > (uint32_t)cp->merge_gap_px) return 0;
+    X0 = a->x0 < b->x0 ? a->x0 : b->x0;
+    X1 = a->x1 > b->x1 ? a->x1 : b->x1;
+    Y0 = a->y0 < b->y0 ? a->y0 : b->y0;
+    Y1 = a->y1 > b->y1 ? a->y1 : b->y1;
+    box = (double)((X1 - X0) / seg->x_step + 1u) * (double)((Y1 - Y0) / seg->y_step + 1u);
+    if ((double)(acc[ia].n + acc[ib].n) < cp->merge_min_density * box) return 0;
+    /* b joins a */
+    acc[ia].n += acc[ib].n; acc[ia].sx += acc[ib].sx; acc[ia].sy += acc[ib].sy;
+    acc[ia].sxx += acc[ib].sxx; acc[ia].syy += acc[ib].syy; acc[ia].sxy += acc[ib].sxy;
+    acc[ib].alive = 0;
+    a->first_run = merge_lists(seg->runs, a->first_run, b->first_run, &acc[ia].last_run);
+    a->n_runs += b->n_runs;
+    a->n_components = (uint16_t)((uint32_t)a->n_components + b->n_components > 0xFFFFu
+                                     ? 0xFFFFu : a->n_components + b->n_components);
+    a->flags |= CYL_BLOB_MERGED;
+    a->x0 = (uint16_t)X0; a->x1 = (uint16_t)X1; a->y0 = (uint16_t)Y0; a->y1 = (uint16_t)Y1;
+    return 1;
+}
+
+static void merge_blobs(cyl_segmentation *seg, blob_acc *acc, uint32_t nb, const cyl_segment_params *p)
+{
+    int changed = 1;
+    while (changed) {
+        uint32_t i, j;
+        changed = 0;
+        for (i = 0; i < nb; i++) {
+            const cyl_class_params *cp;
+            if (!acc[i].alive) continue;
+            cp = &p->cls[seg->blobs[i].cls];
+            if (cp->merge_gap_px < 0) continue;
+            for (j = i + 1u; j < nb; j++)
+                if (acc[j].alive && seg->blobs[j].cls == seg->blobs[i].cls &&
+                    try_merge(seg, acc, i, j, cp))
+                    changed = 1;
+        }
+    }
+}
+
+static void finish_blob(cyl_segmentation *seg, cyl_blob *b, const blob_acc *a)
+{
+    double n = (double)a->n, cx, cy, mxx, myy, mxy, d, l1, l2;
+    b->area = (uint32_t)a->n;
+    cx = (double)a->sx / n;
+    cy = (double)a->sy / n;
+    mxx = ((double)a->sxx - (double)a->sx * cx) / n;
+    myy = ((double)a->syy - (double)a->sy * cy) / n;
+    mxy = ((double)a->sxy - (double)a->sx * cy) / n;
+    if (mxx < 0) mxx = 0;
+    if (myy < 0) myy = 0;
+    b->cx_px = cx; b->cy_px = cy;
+    b->mxx_px2 = mxx; b->myy_px2 = myy; b->mxy_px2 = mxy;
+    b->orientation_rad = (mxy == 0.0 && mxx >= myy) ? 0.0 : 0.5 * atan2(2.0 * mxy, mxx - myy);
+    d = sqrt(0.25 * (mxx - myy) * (mxx - myy) + mxy * mxy);
+    l1 = 0.5 * (mxx + myy) + d;
+    l2 = 0.5 * (mxx + myy) - d;
+    if (l2 < 0) l2 = 0;
+    b->elongation = l1 > 0 ? 1.0 - sqrt(l2 / l1) : 0.0;
+    if (b->x0 == seg->x_origin) b->flags |= CYL_BLOB_TOUCH_LEFT;
+    if (b->x1 == seg->x_last) b->flags |= CYL_BLOB_TOUCH_RIGHT;
+    if (b->y0 == seg->y_origin) b->flags |= CYL_BLOB_TOUCH_TOP;
+    if (b->y1 == seg->y_last) b->flags |= CYL_BLOB_TOUCH_BOTTOM;
+}
+
+/* Total order: class ascending, area descending, y0, x0, first run. */
+static int blob_before(const cyl_blob *a, const cyl_blob *b)
+{
+    if (a->cls != b->cls) return a->cls < b->cls;
+    if (a->area != b->area) return a->area > b->area;
+    if (a->y0 != b->y0) return a->y0 < b->y0;
+    if (a->x0 != b->x0) return a->x0 < b->x0;
+    return a->first_run < b->first_run;
+}
+
+static void sift_down(cyl_blob *v, uint32_t i, uint32_t n)
+{
+    for (;;) {
+        uint32_t c = 2u * i + 1u, m = i;
+        cyl_blob tmp;
+        if (c < n && blob_before(&v[m], &v[c])) m = c;
+        if (c + 1u < n && blob_before(&v[m], &v[c + 1u])) m = c + 1u;
+        if (m == i) return;
+        tmp = v[i]; v[i] = v[m]; v[m] = tmp;
+        i = m;
+    }
+}
+
+static void sort_blobs(cyl_blob *v, uint32_t n)
+{
+    uint32_t i;
+    if (n < 2) return;
+    for (i = n / 2u; i-- > 0;) sift_down(v, i, n);
+    for (i = n - 1u; i > 0; i--) {
+        cyl_blob tmp = v[0]; v[0] = v[i]; v[i] = tmp;
+        sift_down(v, 0, i);
+    }
+}
+
+static cyl_status check_params(const cyl_segment_params *p)
+{
+    unsigned i;
+    if (p->min_run_px == 0 || p->x_step == 0 || p->y_step == 0) return CYL_ERR_ARG;
+    for (i = 0; i < CYL_MAX_CLASSES; i++) {
+        double d = p->cls[i].merge_min_density;
+        if (!(d >= 0.0 && d <= 1.0)) return CYL_ERR_ARG;
+    }
+    return CYL_OK;
+}
+
+cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
+                       const cyl_segment_params *p, cyl_segmentation *seg)
+{
+    cyl_segment_params defaults;
+    cyl_roi r;
+    rle_ctx ctx;
+    blob_acc *acc;
+    cyl_run *runs;
+    uint32_t xs, ys, nx, y, prev_b = 0, prev_e = 0, i, nb = 0, k;
+    cyl_status s;
+
+    if (!t || !seg || !seg->runs || !seg->blobs || !seg->work) return CYL_ERR_ARG;
+    if (!p) { defaults = cyl_segment_params_default(); p = &defaults; }
+    s = check_params(p);
+    if (s != CYL_OK) return s;
+    s = cyl_image_check(img);
+    if (s != CYL_OK) return s;
+    if (!cyl_roi_resolve(img, &p->roi, &r)) return CYL_ERR_SIZE;
+
+    xs = p->x_step;
+    ys = p->y_step;
+    nx = (r.width + xs - 1u) / xs;
+    seg->n_runs = 0;
+    seg->n_blobs = 0;
+    seg->truncated = 0;
+    seg->x_step = (uint16_t)xs;
+    seg->y_step = (uint16_t)ys;
+    seg->x_origin = r.x;
+    seg->y_origin = r.y;
+    seg->x_last = r.x + (nx - 1u) * xs;
+    seg->y_last = r.y + ((r.height - 1u) / ys) * ys;
+    seg->frame_width = img->width;
+    seg->frame_height = img->height;
+    for (k = 0; k < CYL_MAX_CLASSES; k++) { seg->class_first[k] = 0; seg->class_count[k] = 0; }
+
+    /* 1. classify + run-length encode, connecting each row to the previous one */
+    runs = seg->runs;
+    ctx.runs = runs;
+    ctx.n = 0;
+    ctx.max = seg->max_runs;
+    ctx.min_run = p->min_run_px;
+    ctx.full = 0;
+    for (y = r.y; y < r.y + r.height; y += ys) {
+        uint32_t b = ctx.n;
+        int ok = encode_row(&ctx, t, img, y, r.x, xs, nx);
+        connect_rows(runs, prev_b, prev_e, b, ctx.n, xs);
+        prev_b = b;
+        prev_e = ctx.n;
+        if (!ok) break;
+    }
+    seg->n_runs = ctx.n;
+    if (ctx.full) seg->truncated |= CYL_SEG_RUNS_FULL;
+
+    /* 2. labels: flatten, then number the roots in raster order. A root's
+     *    label is parked in its `next` field until every run is labelled. */
+    for (i = 0; i < ctx.n; i++) runs[i].blob = runs[runs[i].blob].blob;
+    for (i = 0; i < ctx.n; i++) {
+        uint32_t root = runs[i].blob;
+        if (root == i) {
+            if (nb < seg->max_blobs) runs[i].next = nb++;
+            else { runs[i].next = CYL_NONE; seg->truncated |= CYL_SEG_BLOBS_FULL; }
+        }
+        runs[i].blob = runs[root].next;
+    }
+
+    /* 3. accumulate statistics and run lists */
+    acc = (blob_acc *)seg->work;
+    for (k = 0; k < nb; k++) {
+        memset(&acc[k], 0, sizeof acc[k]);
+        acc[k].alive = 1;
+    }
+    for (i = 0; i < ctx.n; i++) {
+        cyl_run *rn = &runs[i];
+        uint32_t bi = rn->blob, xe;
+        cyl_blob *b;
+        rn->next = CYL_NONE;
+        if (bi == CYL_NONE) continue;
+        b = &seg->blobs[bi];
+        xe = rn->x + (uint32_t)(rn->width - 1u) * xs;
+        if (acc[bi].n == 0) {
+            memset(b, 0, sizeof *b);
+            b->cls = rn->cls;
+            b->n_components = 1;
+            b->x0 = rn->x; b->x1 = (uint16_t)xe; b->y0 = rn->y; b->y1 = rn->y;
+            b->first_run = i;
+        } else {
+            runs[acc[bi].last_run].next = i;
+            if (rn->x < b->x0) b->x0 = rn->x;
+            if (xe > b->x1) b->x1 = (uint16_t)xe;
+            b->y1 = rn->y;
+        }
+        acc[bi].last_run = i;
+        b->n_runs++;
+        acc_add_run(&acc[bi], rn, xs);
+    }
+
+    /* 4. merge nearby blobs of a class, finish, filter, compact, sort */
+    merge_blobs(seg, acc, nb, p);
+    k = 0;
+    for (i = 0; i < nb; i++) {
+        if (!acc[i].alive || acc[i].n < (int64_t)p->cls[seg->blobs[i].cls].min_area) continue;
+        if (k != i) seg->blobs[k] = seg->blobs[i];
+        finish_blob(seg, &seg->blobs[k], &acc[i]);
+        k++;
+    }
+    seg->n_blobs = k;
+    sort_blobs(seg->blobs, k);
+
+    /* 5. final labels: runs of dropped blobs get CYL_NONE */
+    for (i = 0; i < ctx.n; i++) runs[i].blob = CYL_NONE;
+    for (k = 0; k < seg->n_blobs; k++) {
+        uint32_t ri;
+        for (ri = seg->blobs[k].first_run; ri != CYL_NONE; ri = runs[ri].next) runs[ri].blob = k;
+        if (seg->class_count[seg->blobs[k].cls]++ == 0) seg->class_first[seg->blobs[k].cls] = k;
+    }
+    return seg->truncated ? CYL_TRUNCATED : CYL_OK;
+}

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Run test programs (cmocka, GoogleTest or pytest), print each one's result and
+# a closing "N passed, N failed" line. Exit non-zero if anything failed or crashed.
+set -u
+passed=0; failed=0; broken=()
+for t in "$@"; do
+  out=$(mktemp)
+  if [[ "$t" == pytest:* ]]; then
+    cmd=(${t#pytest:})
+  else
+    cmd=("$t")
+  fi
+  "${cmd[@]}" >"$out" 2>&1
+  rc=$?
+  # cmocka: "[  PASSED  ] N test(s)."  GoogleTest: "[  PASSED  ] N tests."
+  p=$(grep -aoE '^\[  PASSED  \] [0-9]+ test' "$out" | awk '{s+=$4} END{print s+0}')
+  f=$(grep -aoE '^\[  FAILED  \] [0-9]+ test' "$out" | awk '{s+=$4} END{print s+0}')
+  if [[ "$t" == pytest:* ]]; then
+    p=$(grep -aoE '[0-9]+ passed' "$out" | tail -1 | awk '{print $1+0}'); p=${p:-0}
+    f=$(grep -aoE '[0-9]+ (failed|error)' "$out" | tail -1 | awk '{print $1+0}'); f=${f:-0}
+  fi
+  name=$(basename "${cmd[0]}")
+  if [ $rc -ne 0 ] || [ "$f" -gt 0 ] || [ "$p" -eq 0 ]; then
+    echo "FAIL  $name (exit $rc, $p passed, $f failed)"
+    grep -aE 'FAILED|ERROR|Assert|error|failure|Failure' "$out" | head -40 | sed 's/^/      /'
+    broken+=("$name")
+    [ "$f" -eq 0 ] && f=1
+  else
+    echo "ok    $name ($p passed)"
+  fi
+  passed=$((passed + p)); failed=$((failed + f))
+  rm -f "$out"
+done
+echo "${passed} passed, ${failed} failed"
+[ ${#broken[@]} -eq 0 ]

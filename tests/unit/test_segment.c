@@ -1,0 +1,544 @@
+/* Segmentation: hand-derived cases and a brute-force reference on random frames. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cyl/segment.h"
+#include "synth_frames.h"
+#include "ref_segment.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/* Colours (Y, U, V) used throughout. */
+#define ORANGE 150, 80, 190
+#define GREEN 140, 60, 70
+#define GREY 120, 128, 128
+
+static cyl_colortable table;
+
+static void make_table(void)
+{
+    cyl_colortable_init(&table);
+    cyl_colortable_set_class(&table, 0, "orange", 255, 128, 0);
+    cyl_colortable_set_class(&table, 1, "green", 0, 200, 0);
+    cyl_colortable_add_box(&table, 0, 40, 250, 70, 90, 180, 200);
+    cyl_colortable_add_box(&table, 1, 40, 250, 50, 70, 60, 80);
+}
+
+typedef struct fixture {
+    canvas c;
+    uint8_t *buf;
+    size_t cap;
+    cyl_image img;
+    void *mem;
+    cyl_segmentation seg;
+    cyl_segment_params p;
+} fixture;
+
+static void fx_open(fixture *f, uint32_t w, uint32_t h, uint32_t max_runs, uint32_t max_blobs)
+{
+    size_t ms;
+    make_table();
+    assert_true(canvas_alloc(&f->c, w, h));
+    canvas_fill(&f->c, GREY);
+    f->cap = ((size_t)w * 2 + 400) * h * 3 + 4096;
+    f->buf = (uint8_t *)malloc(f->cap);
+    ms = cyl_segment_mem_size(max_runs, max_blobs);
+    assert_true(ms > 0);
+    f->mem = malloc(ms);
+    assert_int_equal(cyl_segmentation_init(&f->seg, f->mem, ms, max_runs, max_blobs), CYL_OK);
+    f->p = cyl_segment_params_default();
+    {
+        unsigned k;
+        for (k = 0; k < CYL_MAX_CLASSES; k++) { f->p.cls[k].min_area = 1; f->p.cls[k].merge_gap_px = -1; }
+    }
+}
+
+static void fx_close(fixture *f)
+{
+    canvas_free(&f->c);
+    free(f->buf);
+    free(f->mem);
+}
+
+static cyl_status fx_run(fixture *f, cyl_pixfmt fmt, size_t stride)
+{
+    assert_true(canvas_to_format(&f->c, fmt, stride, 0xA5, f->buf, f->cap, &f->img));
+    return cyl_segment(&table, &f->img, &f->p, &f->seg);
+}
+
+static void test_rectangles_exact(void **state)
+{
+    fixture f;
+    const cyl_blob *b;
+    (void)state;
+    fx_open(&f, 64, 48, 1000, 100);
+    canvas_rect(&f.c, 10, 5, 8, 20, ORANGE);   /* 160 px, centroid (13.5, 14.5) */
+    canvas_rect(&f.c, 40, 30, 12, 6, GREEN);   /* 72 px, centroid (45.5, 32.5) */
+    canvas_rect(&f.c, 30, 2, 4, 4, ORANGE);    /* 16 px */
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 3);
+    assert_int_equal(f.seg.class_count[0], 2);
+    assert_int_equal(f.seg.class_count[1], 1);
+    assert_int_equal(f.seg.class_first[1], 2);
+    b = &f.seg.blobs[0];
+    assert_int_equal(b->cls, 0);
+    assert_int_equal(b->area, 160);
+    assert_int_equal(b->x0, 10); assert_int_equal(b->x1, 17);
+    assert_int_equal(b->y0, 5); assert_int_equal(b->y1, 24);
+    assert_int_equal(b->n_runs, 20);
+    assert_true(fabs(b->cx_px - 13.5) < 1e-12);
+    assert_true(fabs(b->cy_px - 14.5) < 1e-12);
+    /* variance of a discrete uniform over n values: (n^2 - 1) / 12 */
+    assert_true(fabs(b->mxx_px2 - (64.0 - 1) / 12) < 1e-9);
+    assert_true(fabs(b->myy_px2 - (400.0 - 1) / 12) < 1e-9);
+    assert_true(fabs(b->mxy_px2) < 1e-9);
+    /* tall: major axis along y */
+    assert_true(fabs(fabs(b->orientation_rad) - M_PI / 2) < 1e-9);
+    assert_true(fabs(b->elongation - (1 - sqrt(63.0 / 399.0))) < 1e-9);
+    assert_int_equal(f.seg.blobs[1].area, 16);
+    b = &f.seg.blobs[2];
+    assert_int_equal(b->cls, 1);
+    assert_int_equal(b->area, 72);
+    assert_true(fabs(b->cx_px - 45.5) < 1e-12 && fabs(b->cy_px - 32.5) < 1e-12);
+    assert_int_equal(b->flags, 0);
+    fx_close(&f);
+}
+
+static void test_short_runs_vanish(void **state)
+{
+    fixture f;
+    (void)state;
+    fx_open(&f, 40, 10, 1000, 100);
+    canvas_rect(&f.c, 2, 1, 1, 1, ORANGE);    /* 1 px: dropped */
+    canvas_rect(&f.c, 6, 1, 2, 5, ORANGE);    /* 2-wide column: every run has 2 px, dropped */
+    canvas_rect(&f.c, 12, 1, 3, 2, ORANGE);   /* 3 px runs: kept, 6 px */
+    canvas_rect(&f.c, 20, 4, 10, 1, GREEN);   /* 10 px run */
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 2);
+    assert_int_equal(f.seg.n_runs, 3);
+    assert_int_equal(f.seg.blobs[0].area, 6);
+    assert_int_equal(f.seg.blobs[1].area, 10);
+    /* min_run 1 keeps everything */
+    f.p.min_run_px = 1;
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 4);
+    fx_close(&f);
+}
+
+static void test_touching_classes_apart(void **state)
+{
+    fixture f;
+    (void)state;
+    fx_open(&f, 30, 20, 1000, 100);
+    canvas_rect(&f.c, 5, 5, 5, 5, ORANGE);
+    canvas_rect(&f.c, 10, 5, 5, 5, GREEN);    /* shares an edge with the orange one */
+    canvas_rect(&f.c, 5, 10, 10, 3, GREEN);   /* below both: joins the green one only */
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 2);
+    assert_int_equal(f.seg.blobs[0].cls, 0);
+    assert_int_equal(f.seg.blobs[0].area, 25);
+    assert_int_equal(f.seg.blobs[1].cls, 1);
+    assert_int_equal(f.seg.blobs[1].area, 55);
+    fx_close(&f);
+}
+
+static void test_diagonal_contact_apart(void **state)
+{
+    fixture f;
+    (void)state;
+    fx_open(&f, 30, 20, 1000, 100);
+    canvas_rect(&f.c, 2, 2, 4, 4, ORANGE);    /* ends at (5,5) */
+    canvas_rect(&f.c, 6, 6, 4, 4, ORANGE);    /* starts at (6,6): corner contact only */
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 2);
+    assert_int_equal(f.seg.blobs[0].area, 16);
+    assert_int_equal(f.seg.blobs[1].area, 16);
+    /* a U shape joined only at the bottom is one blob */
+    canvas_fill(&f.c, GREY);
+    canvas_rect(&f.c, 2, 2, 3, 8, ORANGE);
+    canvas_rect(&f.c, 10, 2, 3, 8, ORANGE);
+    canvas_rect(&f.c, 2, 10, 11, 2, ORANGE);
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 1);
+    assert_int_equal(f.seg.blobs[0].area, 24 + 24 + 22);
+    assert_int_equal(f.seg.blobs[0].n_runs, 8 + 8 + 2);
+    fx_close(&f);
+}
+
+/* Two 10x10 squares side by side with a gap of g px between them. */
+static void merge_case(int gap, int32_t merge_gap, double density, int expect_blobs)
+{
+    fixture f;
+    fx_open(&f, 60, 20, 1000, 100);
+    canvas_rect(&f.c, 5, 5, 10, 10, ORANGE);
+    canvas_rect(&f.c, 15 + gap, 5, 10, 10, ORANGE);
+    f.p.cls[0].merge_gap_px = merge_gap;
+    f.p.cls[0].merge_min_density = density;
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, expect_blobs);
+    if (expect_blobs == 1) {
+        const cyl_blob *b = &f.seg.blobs[0];
+        const cyl_run *r;
+        uint32_t k, n = 0, prev = 0;
+        assert_int_equal(b->area, 200);
+        assert_int_equal(b->n_components, 2);
+        assert_true(b->flags & CYL_BLOB_MERGED);
+        assert_int_equal(b->x0, 5);
+        assert_int_equal(b->x1, 24 + gap);
+        assert_true(fabs(b->cx_px - (9.5 + 19.5 + gap) / 2) < 1e-12);
+        assert_int_equal(b->n_runs, 20);
+        /* the merged run list stays in (y, x) order and every run points back */
+        for (k = b->first_run; k != CYL_NONE; k = r->next, n++) {
+            r = &f.seg.runs[k];
+            assert_true(n == 0 || k > prev);
+            assert_int_equal(r->blob, 0);
+            prev = k;
+        }
+        assert_int_equal(n, 20);
+    }
+    fx_close(&f);
+}
+
+static void test_merge_criterion(void **state)
+{
+    (void)state;
+    merge_case(3, 3, 0.0, 1);     /* gap == limit: merged */
+    merge_case(4, 3, 0.0, 2);     /* gap one over: apart */
+    merge_case(3, -1, 0.0, 2);    /* merging disabled */
+    /* density: 200 px in a box of 23 x 10 = 230 -> 0.8696 */
+    merge_case(3, 3, 200.0 / 230.0, 1);
+    merge_case(3, 3, 200.0 / 230.0 + 1e-9, 2);
+    merge_case(1, 1, 1.0, 2);     /* density 200/210 < 1 */
+}
+
+static void test_merge_chain_and_classes(void **state)
+{
+    fixture f;
+    (void)state;
+    fx_open(&f, 80, 20, 1000, 100);
+    /* three fragments in a row: a-b within the gap, b-c within the gap, a-c not */
+    canvas_rect(&f.c, 5, 5, 6, 8, ORANGE);
+    canvas_rect(&f.c, 13, 5, 6, 8, ORANGE);
+    canvas_rect(&f.c, 21, 5, 6, 8, ORANGE);
+    canvas_rect(&f.c, 29, 5, 6, 8, GREEN);   /* other class, also 2 px away: never merged */
+    f.p.cls[0].merge_gap_px = 2;
+    f.p.cls[0].merge_min_density = 0.5;
+    f.p.cls[1].merge_gap_px = 2;
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 2);
+    assert_int_equal(f.seg.blobs[0].area, 144);
+    assert_int_equal(f.seg.blobs[0].n_components, 3);
+    assert_int_equal(f.seg.blobs[1].cls, 1);
+    assert_int_equal(f.seg.blobs[1].area, 48);
+    fx_close(&f);
+}
+
+static void test_min_area_and_order(void **state)
+{
+    fixture f;
+    (void)state;
+    fx_open(&f, 60, 30, 1000, 100);
+    canvas_rect(&f.c, 1, 1, 3, 3, GREEN);     /* 9 */
+    canvas_rect(&f.c, 10, 1, 5, 5, GREEN);    /* 25 */
+    canvas_rect(&f.c, 20, 1, 4, 4, ORANGE);   /* 16 */
+    canvas_rect(&f.c, 30, 10, 4, 4, ORANGE);  /* 16, lower: after the other 16 */
+    canvas_rect(&f.c, 40, 10, 3, 1, ORANGE);  /* 3: under min_area 4 */
+    f.p.cls[0].min_area = 4;
+    f.p.cls[1].min_area = 10;
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 3);
+    assert_int_equal(f.seg.blobs[0].x0, 20);
+    assert_int_equal(f.seg.blobs[1].x0, 30);
+    assert_int_equal(f.seg.blobs[2].area, 25);
+    /* runs of dropped blobs are labelled CYL_NONE */
+    {
+        uint32_t k, none = 0;
+        for (k = 0; k < f.seg.n_runs; k++) if (f.seg.runs[k].blob == CYL_NONE) none++;
+        assert_int_equal(none, 3 + 1);
+    }
+    fx_close(&f);
+}
+
+static void test_border_flags(void **state)
+{
+    fixture f;
+    (void)state;
+    fx_open(&f, 40, 30, 1000, 100);
+    canvas_rect(&f.c, 0, 10, 5, 5, ORANGE);
+    canvas_rect(&f.c, 35, 25, 5, 5, GREEN);
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.blobs[0].flags, CYL_BLOB_TOUCH_LEFT);
+    assert_int_equal(f.seg.blobs[1].flags, CYL_BLOB_TOUCH_RIGHT | CYL_BLOB_TOUCH_BOTTOM);
+    /* inside a ROI the ROI's edges count */
+    f.p.roi.x = 2; f.p.roi.y = 2; f.p.roi.width = 30; f.p.roi.height = 20;
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 1);
+    assert_int_equal(f.seg.blobs[0].x0, 2);
+    assert_int_equal(f.seg.blobs[0].area, 15);
+    assert_int_equal(f.seg.blobs[0].flags, CYL_BLOB_TOUCH_LEFT);
+    fx_close(&f);
+}
+
+static void test_formats_strides_agree(void **state)
+{
+    static const cyl_pixfmt fmts[] = { CYL_FMT_YUYV, CYL_FMT_UYVY, CYL_FMT_NV12, CYL_FMT_I420, CYL_FMT_YUV444P };
+    fixture f;
+    unsigned k;
+    (void)state;
+    fx_open(&f, 64, 48, 1000, 100);
+    /* even-aligned rectangles: chroma subsampling does not change them */
+    canvas_rect(&f.c, 4, 4, 10, 20, ORANGE);
+    canvas_rect(&f.c, 30, 10, 16, 8, GREEN);
+    for (k = 0; k < 5; k++) {
+        size_t strides[3] = { 0, 0, 0 };
+        unsigned s;
+        strides[1] = (fmts[k] == CYL_FMT_YUYV || fmts[k] == CYL_FMT_UYVY) ? 64 * 2 + 36 : 64 + 28;
+        strides[2] = strides[1] + 100;
+        for (s = 0; s < 3; s++) {
+            assert_int_equal(fx_run(&f, fmts[k], strides[s]), CYL_OK);
+            assert_int_equal(f.seg.n_blobs, 2);
+            assert_int_equal(f.seg.blobs[0].area, 200);
+            assert_int_equal(f.seg.blobs[1].area, 128);
+            assert_true(fabs(f.seg.blobs[0].cx_px - 8.5) < 1e-12);
+        }
+    }
+    fx_close(&f);
+}
+
+static void test_roi_and_step(void **state)
+{
+    fixture f;
+    const cyl_blob *b;
+    (void)state;
+    fx_open(&f, 64, 48, 1000, 100);
+    canvas_rect(&f.c, 10, 10, 20, 12, ORANGE);  /* columns 10..29, rows 10..21 */
+    f.p.x_step = 2; f.p.y_step = 3;
+    assert_int_equal(fx_run(&f, CYL_FMT_YUYV, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 1);
+    b = &f.seg.blobs[0];
+    /* sampled columns 10,12,...,28 (10) and rows 12,15,18,21 (4) */
+    assert_int_equal(b->area, 40);
+    assert_int_equal(b->x0, 10); assert_int_equal(b->x1, 28);
+    assert_int_equal(b->y0, 12); assert_int_equal(b->y1, 21);
+    assert_true(fabs(b->cx_px - 19.0) < 1e-12);
+    assert_true(fabs(b->cy_px - 16.5) < 1e-12);
+    assert_int_equal(f.seg.runs[b->first_run].width, 10);
+    /* ROI with an odd origin and step 1 on a packed format */
+    f.p.x_step = 1; f.p.y_step = 1;
+    f.p.roi.x = 13; f.p.roi.y = 11; f.p.roi.width = 21; f.p.roi.height = 5;
+    assert_int_equal(fx_run(&f, CYL_FMT_YUYV, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 1);
+    assert_int_equal(f.seg.blobs[0].area, 17 * 5);
+    assert_int_equal(f.seg.blobs[0].x0, 13);
+    /* bad ROI */
+    f.p.roi.width = 60;
+    assert_int_equal(fx_run(&f, CYL_FMT_YUYV, 0), CYL_ERR_SIZE);
+    fx_close(&f);
+}
+
+static void test_capacity_truncation(void **state)
+{
+    fixture f;
+    int i;
+    (void)state;
+    fx_open(&f, 64, 40, 5, 100);
+    for (i = 0; i < 8; i++) canvas_rect(&f.c, 2 + 7 * i, 2 + i, 5, 1, ORANGE);  /* 8 runs, one per row */
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_TRUNCATED);
+    assert_true(f.seg.truncated & CYL_SEG_RUNS_FULL);
+    assert_int_equal(f.seg.n_runs, 5);
+    assert_int_equal(f.seg.n_blobs, 5);
+    fx_close(&f);
+
+    fx_open(&f, 64, 40, 100, 3);
+    for (i = 0; i < 8; i++) canvas_rect(&f.c, 2 + 7 * i, 2 + i, 5, 1, ORANGE);
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_TRUNCATED);
+    assert_true(f.seg.truncated & CYL_SEG_BLOBS_FULL);
+    assert_int_equal(f.seg.n_runs, 8);
+    assert_int_equal(f.seg.n_blobs, 3);
+    /* the first three components in raster order are the ones kept */
+    assert_int_equal(f.seg.blobs[0].y0, 2);
+    assert_int_equal(f.seg.blobs[2].y0, 4);
+    fx_close(&f);
+
+    /* memory sizing */
+    {
+        uint8_t small[64];
+        cyl_segmentation s;
+        assert_int_equal(cyl_segmentation_init(&s, small, sizeof small, 100, 10), CYL_ERR_NOMEM);
+        assert_int_equal(cyl_segment_mem_size(0xFFFFFFFFu, 1), 0);
+    }
+}
+
+static void test_bad_arguments(void **state)
+{
+    fixture f;
+    (void)state;
+    fx_open(&f, 16, 16, 100, 10);
+    assert_true(canvas_to_format(&f.c, CYL_FMT_YUYV, 0, 0, f.buf, f.cap, &f.img));
+    assert_int_equal(cyl_segment(NULL, &f.img, &f.p, &f.seg), CYL_ERR_ARG);
+    assert_int_equal(cyl_segment(&table, NULL, &f.p, &f.seg), CYL_ERR_ARG);
+    f.p.min_run_px = 0;
+    assert_int_equal(cyl_segment(&table, &f.img, &f.p, &f.seg), CYL_ERR_ARG);
+    f.p.min_run_px = 3;
+    f.p.cls[2].merge_min_density = NAN;
+    assert_int_equal(cyl_segment(&table, &f.img, &f.p, &f.seg), CYL_ERR_ARG);
+    f.p.cls[2].merge_min_density = 0.5;
+    f.img.stride[0] = 31;  /* smaller than a row of 16 YUYV pixels */
+    assert_int_equal(cyl_segment(&table, &f.img, &f.p, &f.seg), CYL_ERR_SIZE);
+    f.img.stride[0] = 32;
+    f.img.format = (cyl_pixfmt)99;
+    assert_int_equal(cyl_segment(&table, &f.img, &f.p, &f.seg), CYL_ERR_FORMAT);
+    /* defaults when params are NULL */
+    f.img.format = CYL_FMT_YUYV;
+    assert_int_equal(cyl_segment(&table, &f.img, NULL, &f.seg), CYL_OK);
+    fx_close(&f);
+}
+
+/* Random frames: the library against the brute-force flood fill. */
+static void test_bruteforce_random(void **state)
+{
+    static const cyl_pixfmt fmts[] = { CYL_FMT_YUYV, CYL_FMT_UYVY, CYL_FMT_NV12, CYL_FMT_I420, CYL_FMT_YUV444P };
+    static const uint8_t speck[4][3] = { { ORANGE }, { GREEN }, { 200, 120, 170 }, { GREY } };
+    test_rng rng;
+    int iter, total_blobs = 0;
+    uint32_t max_runs = 200000, max_blobs = 20000;
+    size_t ms = cyl_segment_mem_size(max_runs, max_blobs);
+    void *mem = malloc(ms);
+    ref_blob *ref = (ref_blob *)malloc(sizeof(ref_blob) * 20000);
+    cyl_segmentation seg;
+    (void)state;
+    make_table();
+    /* a third, overlapping class to exercise the priority rule */
+    cyl_colortable_set_class(&table, 2, "pink", 255, 100, 200);
+    cyl_colortable_add_box(&table, 2, 100, 255, 75, 130, 150, 200);
+    assert_int_equal(cyl_segmentation_init(&seg, mem, ms, max_runs, max_blobs), CYL_OK);
+    test_rng_seed(&rng, 20261122);
+    for (iter = 0; iter < 3000; iter++) {
+        canvas c;
+        cyl_image img;
+        cyl_segment_params p = cyl_segment_params_default();
+        uint32_t w = (uint32_t)test_rng_int(&rng, 1, 90), h = (uint32_t)test_rng_int(&rng, 1, 60);
+        cyl_pixfmt fmt = fmts[test_rng_int(&rng, 0, 4)];
+        int nrect = (int)test_rng_int(&rng, 0, 12), i, n;
+        size_t stride, cap;
+        uint8_t *buf;
+        unsigned k;
+        assert_true(canvas_alloc(&c, w, h));
+        canvas_fill(&c, GREY);
+        for (i = 0; i < nrect; i++) {
+            const uint8_t *col = speck[test_rng_int(&rng, 0, 2)];
+            canvas_rect(&c, (int32_t)test_rng_int(&rng, -5, (int64_t)w), (int32_t)test_rng_int(&rng, -5, (int64_t)h),
+                        (int32_t)test_rng_int(&rng, 1, 30), (int32_t)test_rng_int(&rng, 1, 30), col[0], col[1], col[2]);
+        }
+        canvas_speckle(&c, &rng, test_rng_uniform(&rng) * 0.3, speck, 4);
+        if (test_rng_int(&rng, 0, 1)) canvas_noise(&c, &rng, 4.0, 6.0);
+        stride = test_rng_int(&rng, 0, 1) ? 0 : (size_t)(fmt == CYL_FMT_YUYV || fmt == CYL_FMT_UYVY ? 4 * ((w + 1) / 2) : w) + (size_t)test_rng_int(&rng, 1, 13);
+        cap = canvas_format_size(&c, fmt, stride);
+        buf = (uint8_t *)malloc(cap);
+        assert_true(canvas_to_format(&c, fmt, stride, (uint8_t)test_rng_int(&rng, 0, 255), buf, cap, &img));
+        p.min_run_px = (uint16_t)test_rng_int(&rng, 1, 4);
+        p.x_step = (uint16_t)(test_rng_int(&rng, 0, 3) ? 1 : test_rng_int(&rng, 2, 3));
+        p.y_step = (uint16_t)(test_rng_int(&rng, 0, 3) ? 1 : test_rng_int(&rng, 2, 3));
+        if (test_rng_int(&rng, 0, 2) == 0) {
+            p.roi.x = (uint32_t)test_rng_int(&rng, 0, (int64_t)w - 1);
+            p.roi.y = (uint32_t)test_rng_int(&rng, 0, (int64_t)h - 1);
+            p.roi.width = (uint32_t)test_rng_int(&rng, 1, (int64_t)(w - p.roi.x));
+            p.roi.height = (uint32_t)test_rng_int(&rng, 1, (int64_t)(h - p.roi.y));
+        }
+        for (k = 0; k < CYL_MAX_CLASSES; k++) {
+            p.cls[k].merge_gap_px = -1;
+            p.cls[k].min_area = (uint32_t)test_rng_int(&rng, 0, 6);
+        }
+        assert_int_equal(cyl_segment(&table, &img, &p, &seg), CYL_OK);
+        n = ref_segment(&table, &img, &p, ref, 20000, NULL);
+        assert_int_equal(n, (int)seg.n_blobs);
+        for (i = 0; i < n; i++) {
+            const cyl_blob *b = &seg.blobs[i];
+            const ref_blob *r = &ref[i];
+            uint32_t ri, cnt = 0, area = 0;
+            assert_int_equal(b->cls, r->cls);
+            assert_int_equal(b->area, r->area);
+            assert_int_equal(b->x0, r->x0); assert_int_equal(b->x1, r->x1);
+            assert_int_equal(b->y0, r->y0); assert_int_equal(b->y1, r->y1);
+            assert_int_equal(b->flags & CYL_BLOB_TOUCH_ANY, r->touches);
+            assert_true(fabs(b->cx_px - r->cx) < 1e-9 && fabs(b->cy_px - r->cy) < 1e-9);
+            assert_true(fabs(b->mxx_px2 - r->mxx) < 1e-6 && fabs(b->myy_px2 - r->myy) < 1e-6);
+            assert_true(fabs(b->mxy_px2 - r->mxy) < 1e-6);
+            for (ri = b->first_run; ri != CYL_NONE; ri = seg.runs[ri].next) {
+                assert_int_equal(seg.runs[ri].blob, (uint32_t)i);
+                assert_int_equal(seg.runs[ri].cls, b->cls);
+                area += seg.runs[ri].width;
+                cnt++;
+            }
+            assert_int_equal(cnt, b->n_runs);
+            assert_int_equal(area, b->area);
+        }
+        total_blobs += n;
+        free(buf);
+        canvas_free(&c);
+    }
+    assert_true(total_blobs > 3000); /* the frames were not trivially empty */
+    free(mem);
+    free(ref);
+}
+
+static void test_deterministic(void **state)
+{
+    static const uint8_t speck[2][3] = { { ORANGE }, { GREEN } };
+    fixture f;
+    test_rng rng;
+    cyl_blob *first;
+    cyl_run *runs;
+    uint32_t nb, nr;
+    (void)state;
+    fx_open(&f, 160, 120, 20000, 2000);
+    f.p = cyl_segment_params_default();
+    test_rng_seed(&rng, 7);
+    canvas_rect(&f.c, 20, 20, 30, 60, ORANGE);
+    canvas_rect(&f.c, 52, 20, 20, 60, ORANGE);
+    canvas_speckle(&f.c, &rng, 0.2, speck, 2);
+    canvas_noise(&f.c, &rng, 3, 3);
+    assert_int_equal(fx_run(&f, CYL_FMT_YUYV, 0), CYL_OK);
+    nb = f.seg.n_blobs; nr = f.seg.n_runs;
+    first = (cyl_blob *)malloc(sizeof(cyl_blob) * nb);
+    runs = (cyl_run *)malloc(sizeof(cyl_run) * nr);
+    memcpy(first, f.seg.blobs, sizeof(cyl_blob) * nb);
+    memcpy(runs, f.seg.runs, sizeof(cyl_run) * nr);
+    memset(f.seg.blobs, 0x5A, sizeof(cyl_blob) * nb);
+    assert_int_equal(fx_run(&f, CYL_FMT_YUYV, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, nb);
+    assert_int_equal(f.seg.n_runs, nr);
+    assert_memory_equal(first, f.seg.blobs, sizeof(cyl_blob) * nb);
+    assert_memory_equal(runs, f.seg.runs, sizeof(cyl_run) * nr);
+    free(first); free(runs);
+    fx_close(&f);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_rectangles_exact),
+        cmocka_unit_test(test_short_runs_vanish),
+        cmocka_unit_test(test_touching_classes_apart),
+        cmocka_unit_test(test_diagonal_contact_apart),
+        cmocka_unit_test(test_merge_criterion),
+        cmocka_unit_test(test_merge_chain_and_classes),
+        cmocka_unit_test(test_min_area_and_order),
+        cmocka_unit_test(test_border_flags),
+        cmocka_unit_test(test_formats_strides_agree),
+        cmocka_unit_test(test_roi_and_step),
+        cmocka_unit_test(test_capacity_truncation),
+        cmocka_unit_test(test_bad_arguments),
+        cmocka_unit_test(test_bruteforce_random),
+        cmocka_unit_test(test_deterministic),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
