@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Run test programs (cmocka, GoogleTest or pytest), print each one's result and
+# Run test programs (cmocka, GoogleTest or pytest; "prog:arg:..." passes arguments), print each one's result and
 # a closing "N passed, N failed" line. Exit non-zero if anything failed or crashed.
 set -u
 passed=0; failed=0; broken=()
@@ -7,6 +7,8 @@ for t in "$@"; do
   out=$(mktemp)
   if [[ "$t" == pytest:* ]]; then
     cmd=(${t#pytest:})
+  elif [[ "$t" == *:* ]]; then
+    IFS=: read -r -a cmd <<< "$t"   # "program:arg1:arg2" runs program with those arguments
   else
     cmd=("$t")
   fi
