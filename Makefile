@@ -5,15 +5,26 @@
 # Other targets: bench, cross (Cortex-M4 build of libcyl), install PREFIX=..., clean.
 
 SHELL   := /bin/bash
-BUILD   := build
-HOSTLIB := libcyl/build/host
-LIBCYL_A := $(HOSTLIB)/libcyl.a
 CC      ?= cc
 CXX     ?= c++
+# SAN=1: the same targets built with AddressSanitizer and UndefinedBehaviorSanitizer into
+# build/san (e.g. `make test SAN=1`); any finding aborts the test that hit it.
+ifeq ($(SAN),1)
+BUILD   := build/san
+HOSTLIB := libcyl/build/san
+SANFLAGS := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+export ASAN_OPTIONS := detect_leaks=1:abort_on_error=1
+export UBSAN_OPTIONS := print_stacktrace=1:halt_on_error=1
+else
+BUILD   := build
+HOSTLIB := libcyl/build/host
+SANFLAGS :=
+endif
+LIBCYL_A := $(HOSTLIB)/libcyl.a
 # Host build of the core: what CI enforces (the libcyl Makefile adds -std=c99 -Wall -Wextra -Wpedantic).
-CORE_CFLAGS := -O2 -g -Werror
-TEST_CFLAGS := -std=c99 -O2 -g -Wall -Wextra -Ilibcyl/include -Itests/common
-CXXFLAGS_ALL := -std=c++17 -O2 -g -Wall -Wextra -Ilibcyl/include -Itests/common -Ifrontend/include
+CORE_CFLAGS := -O2 -g -Werror $(SANFLAGS)
+TEST_CFLAGS := -std=c99 -O2 -g -Wall -Wextra -Ilibcyl/include -Itests/common $(SANFLAGS)
+CXXFLAGS_ALL := -std=c++17 -O2 -g -Wall -Wextra -Ilibcyl/include -Itests/common -Ifrontend/include $(SANFLAGS)
 
 DEBS_BUILD := build-essential pkg-config libcmocka-dev
 DEBS_CROSS := gcc-arm-none-eabi libnewlib-arm-none-eabi
@@ -41,7 +52,7 @@ deps: $(STAMP)/debs-build $(STAMP)/debs-cross $(STAMP)/debs-cv $(STAMP)/debs-ben
 
 # ---- the core -------------------------------------------------------------
 lib: $(STAMP)/debs-build
-	$(MAKE) -C libcyl BUILD=build/host CFLAGS='$(CORE_CFLAGS)'
+	$(MAKE) -C libcyl BUILD=$(HOSTLIB:libcyl/%=%) CFLAGS='$(CORE_CFLAGS)'
 
 $(LIBCYL_A): lib
 
@@ -56,7 +67,7 @@ cross: $(STAMP)/debs-cross
 	  awk '{printf "cross: Cortex-M4 libcyl.a text %d B, data %d B, bss %d B; no heap or stdio symbols\n", $$1, $$2, $$3}'
 
 install: lib
-	$(MAKE) -C libcyl BUILD=build/host install PREFIX=$(or $(PREFIX),/usr/local)
+	$(MAKE) -C libcyl BUILD=$(HOSTLIB:libcyl/%=%) install PREFIX=$(or $(PREFIX),/usr/local)
 
 # ---- tests ------------------------------------------------------------------
 TEST_COMMON_SRCS := $(wildcard tests/common/*.c)

@@ -19,8 +19,35 @@ VIVID_SRCS := tests/v4l2/vivid_test.cpp frontend/src/v4l2.cpp frontend/src/rawlo
 $(BUILD)/vivid_test: $(VIVID_SRCS) $(FRONTEND_HDRS) lib
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS_ALL) -static $(VIVID_SRCS) -o $@ $(LIBCYL_A) -lm
+# (not under SAN=1: the static in-VM binary cannot carry the sanitizer runtimes)
+ifneq ($(SAN),1)
 TEST_EXTRA += $(STAMP)/debs-vivid $(BUILD)/vivid_test
 TEST_EXTRA_BINS += scripts/vivid-test.sh:$(BUILD)/vivid_test
+endif
 vivid-test: $(STAMP)/debs-vivid $(BUILD)/vivid_test
 	scripts/vivid-test.sh $(BUILD)/vivid_test
 .PHONY: vivid-test
+
+# ---- the cyl tool -------------------------------------------------------------------------
+FE_SYNTH_SRCS := $(sort $(wildcard frontend/src/synth/*.cpp))
+FE_SYNTH_OBJS := $(FE_SYNTH_SRCS:frontend/src/synth/%.cpp=$(BUILD)/frontend/synth/%.o)
+$(BUILD)/frontend/synth/%.o: frontend/src/synth/%.cpp $(FRONTEND_HDRS) $(wildcard libcyl/include/cyl/*.h) | $(STAMP)/debs-cv
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) -c $< -o $@
+$(BUILD)/cyl: frontend/tools/cyl.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
+	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) $< -o $@ $(FRONTEND_A) $(FE_SYNTH_OBJS) $(LIBCYL_A) $(CV_LIBS) -lm
+tools: $(BUILD)/cyl
+.PHONY: tools
+
+# ---- frontend unit tests (GoogleTest) ------------------------------------------------------
+FE_TEST_SRCS := $(sort $(wildcard tests/frontend/test_*.cpp))
+FE_TEST_BINS := $(FE_TEST_SRCS:tests/frontend/%.cpp=$(BUILD)/tests/fe_%)
+$(BUILD)/tests/fe_%: tests/frontend/%.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) $< -o $@ $(FRONTEND_A) $(FE_SYNTH_OBJS) $(LIBCYL_A) $(CV_LIBS) -lgtest -lgtest_main -pthread -lm
+TEST_EXTRA += $(FE_TEST_BINS)
+TEST_EXTRA_BINS += $(FE_TEST_BINS)
+
+# ---- make bench: end-to-end replay (issue 5) ------------------------------------------------
+$(BUILD)/bench_replay: bench/bench_replay.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
+	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) -O2 $< -o $@ $(FRONTEND_A) $(FE_SYNTH_OBJS) $(LIBCYL_A) $(CV_LIBS) -lm
