@@ -99,8 +99,9 @@ $(BUILD)/bench_segment: bench/bench_segment.cpp $(BENCH_C) lib $(STAMP)/debs-cv
 	$(CXX) $(CXXFLAGS_ALL) -O3 $< $(BENCH_C:tests/common/%.c=$(BUILD)/bench/%.o) -o $@ $(LIBCYL_A) \
 	  $$(pkg-config --cflags --libs opencv4) -lm
 
-bench: $(BUILD)/bench_segment $(STAMP)/debs-bench
-	scripts/bench.sh
+# Each part prints its table; the last line merges every part's JSON fragment.
+bench: $(BUILD)/bench_segment $(BUILD)/bench_uncertainty $(STAMP)/debs-bench
+	@extra=$$($(BUILD)/bench_uncertainty | tee /dev/stderr | tail -1) && BENCH_EXTRA_JSON="$$extra" scripts/bench.sh
 
 clean:
 	rm -rf $(BUILD) libcyl/build

@@ -12,5 +12,7 @@ done
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
 echo "ensure-debs: installing ${missing[*]}" >&2
-$SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+# A mirror that is mid-sync can fail one index; the install below still works from the others
+# and fails loudly itself if a package cannot be had.
+$SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq || echo "ensure-debs: apt-get update reported errors; trying the install anyway" >&2
 $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cerrno>
 #include <csignal>
 #include <cstring>
@@ -223,7 +224,7 @@ V4L2Source::V4L2Source(const V4L2Options &opt) : dev_(opt.device), timeout_ms_(o
         if (opt.fps > 0 && xioctl(fd_, VIDIOC_G_PARM, &parm) == 0 &&
             (parm.parm.capture.capability & V4L2_CAP_TIMEPERFRAME)) {
             parm.parm.capture.timeperframe.numerator = 1000;
-            parm.parm.capture.timeperframe.denominator = (uint32_t)(opt.fps * 1000.0 + 0.5);
+            parm.parm.capture.timeperframe.denominator = (uint32_t)std::lround(opt.fps * 1000.0);
             if (xioctl(fd_, VIDIOC_S_PARM, &parm) == -1) throw Error(err(dev_, "VIDIOC_S_PARM"));
         }
         std::memset(&parm, 0, sizeof parm);

@@ -56,12 +56,11 @@ static size_t layout(cyl_pixfmt f, uint32_t w, uint32_t h, size_t stride, size_t
     if (stride < row_bytes(f, w, 0) || stride > ((size_t)1 << 28)) return 0;
     for (k = 0; k < 3; k++) { st[k] = 0; off[k] = 0; }
     for (k = 0; k < np; k++) {
-        size_t s;
-        if (k == 0) s = stride;
-        else if (f == CYL_FMT_NV12)                          /* UV rows as wide as Y rows, */
-            s = stride >= row_bytes(f, w, 1) ? stride : row_bytes(f, w, 1); /* +1 for odd widths */
-        else if (f == CYL_FMT_I420) s = (stride + 1u) / 2u;  /* the V4L2 YU12 convention */
-        else s = stride;
+        /* Plane 0 and YUV444's chroma planes have the given stride; NV12's UV rows are as wide
+         * as the Y rows (+1 byte for odd widths); I420's are half (the V4L2 YU12 convention). */
+        size_t s = stride;
+        if (k > 0 && f == CYL_FMT_NV12 && s < row_bytes(f, w, 1)) s = row_bytes(f, w, 1);
+        if (k > 0 && f == CYL_FMT_I420) s = (stride + 1u) / 2u;
         if (s < row_bytes(f, w, k)) return 0;
         st[k] = s;
         off[k] = total;

@@ -321,7 +321,9 @@ static int try_merge(cyl_segmentation *seg, blob_acc *acc, uint32_t ia, uint32_t
     X1 = a->x1 > b->x1 ? a->x1 : b->x1;
     Y0 = a->y0 < b->y0 ? a->y0 : b->y0;
     Y1 = a->y1 > b->y1 ? a->y1 : b->y1;
-    box = (double)((X1 - X0) / seg->x_step + 1u) * (double)((Y1 - Y0) / seg->y_step + 1u);
+    /* samples in the merged box: extents are exact multiples of the steps on the sample grid */
+    box = (double)((X1 - X0) / seg->x_step + 1u) * /* NOLINT(bugprone-integer-division) */
+          (double)((Y1 - Y0) / seg->y_step + 1u);  /* NOLINT(bugprone-integer-division) */
     if ((double)(acc[ia].n + acc[ib].n) < cp->merge_min_density * box) return 0;
     /* b joins a */
     acc[ia].n += acc[ib].n; acc[ia].sx += acc[ib].sx; acc[ia].sy += acc[ib].sy;

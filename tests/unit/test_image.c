@@ -71,7 +71,7 @@ static void test_checks(void **state)
     assert_int_equal(cyl_image_wrap(&img, (cyl_pixfmt)0, 2, 2, buf, 0), CYL_ERR_FORMAT);
     assert_int_equal(cyl_image_wrap(&img, CYL_FMT_YUYV, 2, 2, NULL, 0), CYL_ERR_ARG);
     assert_int_equal(cyl_image_buffer_size(CYL_FMT_YUYV, 70000, 70000, 0), 0);
-    assert_int_equal(cyl_image_buffer_size(CYL_FMT_YUYV, 2, 2, (size_t)1 << 40), 0);
+    assert_int_equal(cyl_image_buffer_size(CYL_FMT_YUYV, 2, 2, ((size_t)1 << 28) + 1), 0); /* over the stride limit, on 32 and 64 bit */
     assert_int_equal(cyl_image_wrap(&img, CYL_FMT_I420, 4, 4, buf, 0), CYL_OK);
     img.plane[2] = NULL;
     assert_int_equal(cyl_image_check(&img), CYL_ERR_ARG);

@@ -1,0 +1,232 @@
+// cylfe: camera calibration files (see calibration.hpp).
+#include "cylfe/calibration.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "cylfe/error.hpp"
+
+namespace cylfe {
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+struct Ctx {
+    const std::string &path;
+    [[noreturn]] void fail(const std::string &field, const std::string &what) const
+    {
+        throw Error(path + ": field '" + field + "': " + what);
+    }
+};
+
+// A matrix node: !!opencv-matrix, a ROS {rows, cols, data} map, or a plain sequence.
+// Returns the values row-major; checks the element count against rows*cols when given (> 0).
+std::vector<double> read_matrix(const Ctx &c, const cv::FileNode &n, const std::string &field,
+                                int rows, int cols)
+{
+    std::vector<double> v;
+    if (n.empty() || n.isNone()) c.fail(field, "missing");
+    try {
+        if (n.isMap() && !n["dt"].empty()) {
+            // OpenCV allocates rows x cols before reading the data: check the declared size first
+            // (a fuzzed file declared 2^30 elements).
+            cv::FileNode nr = n["rows"], nc = n["cols"];
+            if (!nr.isInt() || !nc.isInt()) c.fail(field, "opencv-matrix without integer rows and cols");
+            long long dr = (int)nr, dc = (int)nc;
+            long long want = rows > 0 ? (long long)rows * cols : 1024;
+            if (dr <= 0 || dc <= 0 || dr * dc > want)
+                c.fail(field, "declared size " + std::to_string(dr) + "x" + std::to_string(dc) + " out of range");
+            cv::Mat m;
+            n >> m;
+            if (m.empty()) c.fail(field, "empty matrix");
+            m.convertTo(m, CV_64F);
+            if (rows > 0 && (m.rows != rows || m.cols != cols) && !(m.total() == size_t(rows * cols)))
+                c.fail(field, "expected " + std::to_string(rows) + "x" + std::to_string(cols) + ", got " +
+                                  std::to_string(m.rows) + "x" + std::to_string(m.cols));
+            v.assign(m.begin<double>(), m.end<double>());
+        } else {
+            cv::FileNode d = n.isMap() ? n["data"] : n;
+            if (!d.isSeq()) c.fail(field, "expected a matrix (opencv-matrix, {rows, cols, data} or a list)");
+            for (auto it = d.begin(); it != d.end(); ++it) {
+                if (!(*it).isReal() && !(*it).isInt()) c.fail(field, "non-numeric element");
+                v.push_back((double)*it);
+            }
+        }
+    } catch (const cv::Exception &e) {
+        c.fail(field, std::string("unreadable: ") + e.what());
+    }
+    if (rows > 0 && v.size() != size_t(rows * cols))
+        c.fail(field, "expected " + std::to_string(rows * cols) + " values, got " + std::to_string(v.size()));
+    for (double x : v)
+        if (!std::isfinite(x)) c.fail(field, "non-finite value");
+    return v;
+}
+
+bool read_number(const Ctx &c, const cv::FileNode &root, const std::string &field, double *out,
+                 bool required)
+{
+    cv::FileNode n = root[field];
+    if (n.empty() || n.isNone()) {
+        if (required) c.fail(field, "missing");
+        return false;
+    }
+    if (!n.isReal() && !n.isInt()) c.fail(field, "expected a number");
+    *out = (double)n;
+    if (!std::isfinite(*out)) c.fail(field, "non-finite value");
+    return true;
+}
+
+} // namespace
+
+static CameraCalibration load_unchecked(const std::string &path)
+{
+    std::ifstream f(path, std::ios::binary);
+    if (!f) throw Error(path + ": cannot open camera calibration file");
+    std::stringstream ss;
+    ss << f.rdbuf();
+    std::string text = ss.str();
+    CameraCalibration cal;
+    cal.path = path;
+    cal.format = text.rfind("%YAML", 0) == 0 ? "opencv" : "ros";
+    // cv::FileStorage insists on the directive; ROS files are plain YAML without it
+    if (cal.format == "ros") text = "%YAML:1.0\n---\n" + text;
+    cv::FileStorage fs;
+    try {
+        fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+    } catch (const cv::Exception &e) {
+        throw Error(path + ": not a readable YAML calibration file: " + e.what());
+    }
+    if (!fs.isOpened()) throw Error(path + ": not a readable YAML calibration file");
+    Ctx c{path};
+    cv::FileNode root = fs.root();
+    // Field lookups on anything but a mapping assert inside OpenCV: reject such files here.
+    if (!root.isMap()) throw Error(path + ": not a calibration file: the top level is not a mapping of fields");
+    cyl_camera &cam = cal.cam;
+    cyl_camera_init(&cam);
+    cam.height_m = 0.0;
+
+    double w = 0, h = 0;
+    read_number(c, root, "image_width", &w, true);
+    read_number(c, root, "image_height", &h, true);
+    if (w < 1 || h < 1 || w != std::floor(w) || h != std::floor(h)) c.fail("image_width/image_height", "not positive integers");
+    cam.width = (uint32_t)w;
+    cam.height = (uint32_t)h;
+
+    std::vector<double> K = read_matrix(c, root["camera_matrix"], "camera_matrix", 3, 3);
+    if (K[1] != 0.0) c.fail("camera_matrix", "skew is not supported (K[0][1] must be 0)");
+    if (K[3] != 0.0 || K[6] != 0.0 || K[7] != 0.0 || K[8] != 1.0) c.fail("camera_matrix", "last row must be 0 0 1 and K[1][0] 0");
+    cam.fx_px = K[0];
+    cam.cx_px = K[2];
+    cam.fy_px = K[4];
+    cam.cy_px = K[5];
+    if (!(cam.fx_px > 0) || !(cam.fy_px > 0)) c.fail("camera_matrix", "focal lengths must be positive");
+
+    if (cal.format == "ros") {
+        cv::FileNode m = root["distortion_model"];
+        std::string model = m.isString() ? m.string() : std::string("plumb_bob");
+        if (model != "plumb_bob" && model != "rational_polynomial")
+            c.fail("distortion_model", "'" + model + "' is not supported (plumb_bob or rational_polynomial)");
+    }
+    cv::FileNode dn = root["distortion_coefficients"];
+    if (!dn.empty() && !dn.isNone()) {
+        std::vector<double> D = read_matrix(c, dn, "distortion_coefficients", 0, 0);
+        if (D.size() < 4) c.fail("distortion_coefficients", "expected at least 4 values (k1 k2 p1 p2 [k3])");
+        for (size_t i = 5; i < D.size(); i++)
+            if (D[i] != 0.0) c.fail("distortion_coefficients", "terms beyond k3 (rational/thin prism) are not supported");
+        cam.k1 = D[0]; cam.k2 = D[1]; cam.p1 = D[2]; cam.p2 = D[3];
+        cam.k3 = D.size() > 4 ? D[4] : 0.0;
+    }
+
+    // uncertainty of the intrinsics
+    cv::FileNode cn = root["intrinsic_covariance"], sn = root["intrinsic_sigmas"];
+    if (!cn.empty() && !cn.isNone()) {
+        std::vector<double> C = read_matrix(c, cn, "intrinsic_covariance", CYL_INTR_COUNT, CYL_INTR_COUNT);
+        for (int i = 0; i < CYL_INTR_COUNT; i++)
+            for (int j = 0; j < CYL_INTR_COUNT; j++) cam.intr_cov[i][j] = C[i * CYL_INTR_COUNT + j];
+        cam.flags &= ~CYL_CAM_INTR_COV_UNKNOWN;
+        cal.intrinsic_cov_known = true;
+    } else if (!sn.empty() && !sn.isNone()) {
+        std::vector<double> S = read_matrix(c, sn, "intrinsic_sigmas", 0, 0);
+        if (S.size() != 4 && S.size() != CYL_INTR_COUNT)
+            c.fail("intrinsic_sigmas", "expected 4 (fx fy cx cy) or 9 (+ k1 k2 p1 p2 k3) values");
+        double s9[CYL_INTR_COUNT] = {0};
+        for (size_t i = 0; i < S.size(); i++) {
+            if (S[i] < 0) c.fail("intrinsic_sigmas", "negative standard deviation");
+            s9[i] = S[i];
+        }
+        cyl_camera_set_intrinsic_sigmas(&cam, s9);
+        cal.intrinsic_cov_known = true;
+    }
+
+    // mounting
+    double tilt = 0, yaw = 0, hm = 0, s = 0;
+    int nv = read_number(c, root, "mount_tilt_deg", &tilt, false) + read_number(c, root, "mount_yaw_deg", &yaw, false) +
+             read_number(c, root, "mount_height_m", &hm, false) + read_number(c, root, "mount_offset_m", &s, false);
+    if (nv != 0 && nv != 4)
+        c.fail("mount_*", "give all of mount_tilt_deg, mount_yaw_deg, mount_height_m, mount_offset_m or none");
+    if (nv == 4) {
+        if (!(hm > 0)) c.fail("mount_height_m", "must be positive");
+        cam.tilt_rad = tilt * kDeg;
+        cam.yaw_rad = yaw * kDeg;
+        cam.height_m = hm;
+        cam.offset_m = s;
+        cal.mount_known = true;
+    }
+    double st = 0, sy = 0, sh = 0, so = 0;
+    int ns = read_number(c, root, "mount_tilt_sigma_deg", &st, false) + read_number(c, root, "mount_yaw_sigma_deg", &sy, false) +
+             read_number(c, root, "mount_height_sigma_m", &sh, false) + read_number(c, root, "mount_offset_sigma_m", &so, false);
+    if (ns != 0 && ns != 4)
+        c.fail("mount_*_sigma_*", "give all four mount sigmas or none");
+    if (ns == 4) {
+        if (st < 0 || sy < 0 || sh < 0 || so < 0) c.fail("mount_*_sigma_*", "negative standard deviation");
+        cam.tilt_sigma_rad = st * kDeg;
+        cam.yaw_sigma_rad = sy * kDeg;
+        cam.height_sigma_m = sh;
+        cam.offset_sigma_m = so;
+        cam.flags &= ~CYL_CAM_EXTR_SIG_UNKNOWN;
+        cal.mount_sigmas_known = true;
+    }
+    // validate what the C core will see (a placeholder height when the mount is unknown)
+    cyl_camera chk = cam;
+    if (!cal.mount_known) chk.height_m = 1.0;
+    cyl_status ok = cyl_camera_check(&chk);
+    if (ok != CYL_OK) throw Error(path + ": invalid camera: " + cyl_status_str(ok));
+    return cal;
+}
+
+CameraCalibration load_camera_calibration(const std::string &path)
+{
+    try {
+        return load_unchecked(path);
+    } catch (const Error &) {
+        throw;
+    } catch (const std::exception &e) {
+        // What OpenCV's parser still throws on malformed input (cv::Exception, and std::length_error
+        // from inside cv::FileStorage on some inputs; both found by fuzzing): an error naming the file.
+        throw Error(path + ": unreadable calibration file: " + e.what());
+    }
+}
+
+void save_camera_calibration(const std::string &path, const cyl_camera &cam)
+{
+    cv::FileStorage fs(path, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
+    if (!fs.isOpened()) throw Error(path + ": cannot write camera calibration file");
+    fs << "image_width" << (int)cam.width << "image_height" << (int)cam.height;
+    cv::Mat K = (cv::Mat_<double>(3, 3) << cam.fx_px, 0, cam.cx_px, 0, cam.fy_px, cam.cy_px, 0, 0, 1);
+    cv::Mat D = (cv::Mat_<double>(1, 5) << cam.k1, cam.k2, cam.p1, cam.p2, cam.k3);
+    fs << "camera_matrix" << K << "distortion_coefficients" << D;
+    cv::Mat C(CYL_INTR_COUNT, CYL_INTR_COUNT, CV_64F);
+    for (int i = 0; i < CYL_INTR_COUNT; i++)
+        for (int j = 0; j < CYL_INTR_COUNT; j++) C.at<double>(i, j) = cam.intr_cov[i][j];
+    fs << "intrinsic_covariance" << C;
+    fs << "mount_tilt_deg" << cam.tilt_rad / kDeg << "mount_yaw_deg" << cam.yaw_rad / kDeg
+       << "mount_height_m" << cam.height_m << "mount_offset_m" << cam.offset_m;
+    fs << "mount_tilt_sigma_deg" << cam.tilt_sigma_rad / kDeg << "mount_yaw_sigma_deg" << cam.yaw_sigma_rad / kDeg
+       << "mount_height_sigma_m" << cam.height_sigma_m << "mount_offset_sigma_m" << cam.offset_sigma_m;
+}
+
+} // namespace cylfe

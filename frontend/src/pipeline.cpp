@@ -1,0 +1,221 @@
+#include "cylfe/pipeline.hpp"
+#include "cylfe/error.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+
+namespace cylfe {
+
+// ---- names --------------------------------------------------------------------------
+
+const char *model_name(cyl_geom_model m) { return m == CYL_GEOM_PAPER ? "paper" : "exact"; }
+
+const char *estimator_name(cyl_noise_estimator e)
+{
+    switch (e) {
+    case CYL_NOISE_UNIFORM: return "uniform";
+    case CYL_NOISE_COLUMN: return "column";
+    case CYL_NOISE_LOCAL: return "local";
+    }
+    return "?";
+}
+
+bool parse_model(const std::string &s, cyl_geom_model *m)
+{
+    if (s == "exact") { *m = CYL_GEOM_EXACT; return true; }
+    if (s == "paper") { *m = CYL_GEOM_PAPER; return true; }
+    return false;
+}
+
+bool parse_estimator(const std::string &s, cyl_noise_estimator *e)
+{
+    if (s == "uniform") { *e = CYL_NOISE_UNIFORM; return true; }
+    if (s == "column") { *e = CYL_NOISE_COLUMN; return true; }
+    if (s == "local") { *e = CYL_NOISE_LOCAL; return true; }
+    return false;
+}
+
+// ---- detector -------------------------------------------------------------------------
+
+Detector::Detector(const cyl_colortable &table, const cyl_camera &camera, const DetectorConfig &config)
+    : table_(table), camera_(camera), config_(config)
+{
+    check(cyl_camera_check(&camera_), "camera");
+    size_t n = cyl_segment_mem_size(config_.max_runs, config_.max_blobs);
+    if (n == 0) throw Error("detector: run/blob capacities too large");
+    seg_mem_.resize(n);
+    check(cyl_segmentation_init(&seg_, seg_mem_.data(), seg_mem_.size(), config_.max_runs, config_.max_blobs),
+          "detector: segmentation memory");
+    obs_.resize(config_.max_observations);
+}
+
+const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
+{
+    cyl_status s = cyl_segment(&table_, &img, &config_.segment, &seg_);
+    check(s, "segmentation");
+    truncated_ = s == CYL_TRUNCATED;
+    size_t need = cyl_observe_work_size(&seg_, &config_.observe);
+    if (obs_work_.size() < need) obs_work_.resize(need);  // grows to the largest frame seen, once
+    obs_.resize(config_.max_observations);
+    uint32_t n = 0;
+    s = cyl_observe(&seg_, &camera_, &config_.observe, obs_work_.data(), obs_work_.size(), obs_.data(),
+                    (uint32_t)obs_.size(), &n);
+    check(s, "observation");
+    truncated_ = truncated_ || s == CYL_TRUNCATED;
+    obs_.resize(n);
+    return obs_;
+}
+
+// ---- observation log ------------------------------------------------------------------
+
+namespace {
+
+// A JSON number; non-finite values become null (JSON has no NaN).
+std::string num(double v)
+{
+    if (!std::isfinite(v)) return "null";
+    char b[32];
+    std::snprintf(b, sizeof b, "%.10g", v);
+    return b;
+}
+
+std::string str(const std::string &s)
+{
+    std::string o = "\"";
+    for (char c : s) {
+        if (c == '"' || c == '\\') { o += '\\'; o += c; }
+        else if ((unsigned char)c < 0x20) { char b[8]; std::snprintf(b, sizeof b, "\\u%04x", c); o += b; }
+        else o += c;
+    }
+    return o + "\"";
+}
+
+std::string t_sec(int64_t t_ns)
+{
+    char b[40];
+    std::snprintf(b, sizeof b, "%.9f", (double)t_ns * 1e-9);
+    return b;
+}
+
+} // namespace
+
+ObservationLog::ObservationLog(const std::string &path, const Header &h) : path_(path), table_(h.table)
+{
+    if (path == "-") {
+        f_ = stdout;
+        is_stdout_ = true;
+    } else {
+        part_ = path + ".part";
+        f_ = std::fopen(part_.c_str(), "w");
+        if (!f_) throw Error(part_ + ": cannot create: " + std::strerror(errno));
+    }
+    std::string line = "{\"type\":\"header\",\"format\":\"cyl-observations\",\"version\":1,\"source\":" + str(h.source) +
+                       ",\"model\":" + str(h.model) + ",\"estimator\":" + str(h.estimator) + ",\"classes\":[";
+    for (int i = 0; i < CYL_MAX_CLASSES; i++) {
+        if (i) line += ",";
+        line += str(h.table ? h.table->name[i] : "");
+    }
+    line += "]";
+    if (h.camera) {
+        const cyl_camera &c = *h.camera;
+        line += ",\"camera\":{\"width\":" + std::to_string(c.width) + ",\"height\":" + std::to_string(c.height) +
+                ",\"fx\":" + num(c.fx_px) + ",\"fy\":" + num(c.fy_px) + ",\"cx\":" + num(c.cx_px) +
+                ",\"cy\":" + num(c.cy_px) + ",\"tilt_rad\":" + num(c.tilt_rad) + ",\"yaw_rad\":" + num(c.yaw_rad) +
+                ",\"height_m\":" + num(c.height_m) + ",\"offset_m\":" + num(c.offset_m) + "}";
+    }
+    write(line + "}");
+}
+
+ObservationLog::~ObservationLog()
+{
+    if (f_ && !is_stdout_) std::fclose(f_);  // not closed: keep the .part file
+}
+
+void ObservationLog::write(const std::string &line)
+{
+    if (!f_) throw Error(path_ + ": write after close");
+    if (std::fputs(line.c_str(), f_) < 0 || std::fputc('\n', f_) == EOF)
+        throw Error((is_stdout_ ? std::string("stdout") : part_) + ": write failed: " + std::strerror(errno));
+    lines_++;
+}
+
+namespace {
+
+// One JSON object on one line, built by appending (no temporaries per field).
+class JsonLine {
+public:
+    explicit JsonLine(const char *type) { s_.reserve(512); s_ += "{\"type\":\""; s_ += type; s_ += '"'; }
+    JsonLine &num(const char *key, double v) { k(key); s_ += ::cylfe::num(v); return *this; }
+    JsonLine &integer(const char *key, uint64_t v) { k(key); s_ += std::to_string(v); return *this; }
+    JsonLine &raw(const char *key, const std::string &v) { k(key); s_ += v; return *this; }
+    JsonLine &text(const char *key, const std::string &v) { k(key); s_ += str(v); return *this; }
+    const std::string &done() { s_ += '}'; return s_; }
+
+private:
+    void k(const char *key) { s_ += ",\""; s_ += key; s_ += "\":"; }
+    std::string s_;
+};
+
+} // namespace
+
+void ObservationLog::frame(uint64_t seq, int64_t t_ns, const std::vector<cyl_observation> &obs)
+{
+    const std::string t = t_sec(t_ns);
+    write(JsonLine("frame").integer("seq", seq).raw("t", t).integer("n_obs", obs.size()).done());
+    for (const cyl_observation &o : obs) {
+        JsonLine l("obs");
+        l.integer("seq", seq).raw("t", t).text("class", table_ ? table_->name[o.cls] : std::to_string(o.cls));
+        l.integer("class_id", o.cls).num("range_m", o.range_m).num("bearing_rad", o.bearing_rad);
+        l.num("cov_rr", o.cov_rb[0][0]).num("cov_rb", o.cov_rb[0][1]).num("cov_bb", o.cov_rb[1][1]);
+        l.num("x_m", o.x_m).num("y_m", o.y_m);
+        l.num("cov_xx", o.cov_xy[0][0]).num("cov_xy", o.cov_xy[0][1]).num("cov_yy", o.cov_xy[1][1]);
+        l.num("confidence", o.confidence).num("u_px", o.u_px).num("v_px", o.v_px);
+        l.num("var_u_px2", o.var_u_px2).num("var_v_px2", o.var_v_px2);
+        l.integer("area_px", o.area).integer("flags", o.flags);
+        write(l.done());
+    }
+    std::fflush(f_);
+}
+
+void ObservationLog::odometry(uint64_t seq, int64_t t_ns, const Odometry &o)
+{
+    std::string cov;
+    for (int i = 0; i < 6; i++) {
+        if (i) cov += ",";
+        cov += num(o.cov[i]);
+    }
+    write("{\"type\":\"odom\",\"seq\":" + std::to_string(seq) + ",\"t\":" + t_sec(t_ns) + ",\"dx_m\":" + num(o.dx_m) +
+          ",\"dy_m\":" + num(o.dy_m) + ",\"dtheta_rad\":" + num(o.dtheta_rad) + ",\"cov\":[" + cov + "]}");
+    std::fflush(f_);
+}
+
+void ObservationLog::truth_pose(uint64_t seq, int64_t t_ns, const TruthPose &p)
+{
+    write("{\"type\":\"truth_pose\",\"seq\":" + std::to_string(seq) + ",\"t\":" + t_sec(t_ns) + ",\"x_m\":" +
+          num(p.x_m) + ",\"y_m\":" + num(p.y_m) + ",\"theta_rad\":" + num(p.theta_rad) + "}");
+    std::fflush(f_);
+}
+
+void ObservationLog::truth_landmark(const TruthLandmark &l)
+{
+    std::string name = table_ && l.cls < CYL_MAX_CLASSES ? table_->name[l.cls] : std::to_string(l.cls);
+    write("{\"type\":\"truth_landmark\",\"id\":" + std::to_string(l.id) + ",\"class\":" + str(name) +
+          ",\"class_id\":" + std::to_string(l.cls) + ",\"x_m\":" + num(l.x_m) + ",\"y_m\":" + num(l.y_m) +
+          ",\"diameter_m\":" + num(l.diameter_m) + ",\"height_m\":" + num(l.height_m) + "}");
+    std::fflush(f_);
+}
+
+void ObservationLog::close()
+{
+    if (!f_) return;
+    if (is_stdout_) { std::fflush(f_); f_ = nullptr; return; }
+    int bad = std::fflush(f_) != 0;
+    bad |= std::fclose(f_) != 0;
+    f_ = nullptr;
+    if (bad) throw Error(part_ + ": write failed: " + std::strerror(errno));
+    if (std::rename(part_.c_str(), path_.c_str()) != 0)
+        throw Error(part_ + ": cannot rename to " + path_ + ": " + std::strerror(errno));
+}
+
+} // namespace cylfe

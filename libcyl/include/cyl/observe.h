@@ -1,0 +1,98 @@
+/* libcyl -- from a frame's blobs to landmark observations with uncertainty
+ * (the whole of paper section 2 in one call; docs/uncertainty.md).
+ *
+ * For every blob of an observed class, in the order of seg->blobs:
+ *   1. measurement point = the blob's centroid (mean of its samples, px) and its variance by
+ *      the chosen estimator (cyl_noise_blob). The camera height h is the height of the optical
+ *      centre above the landmark's centroid, so the ray through the blob centroid meets the
+ *      plane h below the camera at the landmark's centroid height: the range is to the
+ *      visible face of the landmark at that height (add diameter/2 for its axis).
+ *   2. range, bearing, their 2x2 covariance and the (x, y) covariance (cyl_range_bearing),
+ *      input covariance: diag(var_u, var_v) + the camera's intrinsic covariance + mounting
+ *      sigmas.
+ *   3. confidence (cyl_landmark_confidence) at the depth of the measured point.
+ * Rays at or above the horizon give an observation flagged CYL_OBS_NO_RANGE (bearing and its
+ * variance valid, range 0, confidence 0); blobs whose point cannot be undistorted are flagged
+ * CYL_OBS_INVALID. No allocation: the caller gives the output array and a workspace.
+ */
+#ifndef CYL_OBSERVE_H
+#define CYL_OBSERVE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "cyl/status.h"
+#include "cyl/segment.h"
+#include "cyl/camera.h"
+#include "cyl/noise.h"
+#include "cyl/confidence.h"
+#include "cyl/rangebearing.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* cyl_observation.flags: the blob's CYL_BLOB_TOUCH_* (0x01..0x08) and CYL_BLOB_MERGED (0x10)
+ * bits are copied, plus: */
+#define CYL_OBS_CUT         0x020u  /* cut by the border of the sampled region: not a whole landmark */
+#define CYL_OBS_NO_SIZE     0x040u  /* class has no configured physical size: confidence 0 */
+#define CYL_OBS_NO_RANGE    CYL_RB_NO_RANGE  /* 0x100: at/above the horizon; bearing only */
+#define CYL_OBS_INVALID     0x200u  /* undistortion or geometry failed: only u, v, variances valid */
+#define CYL_OBS_NONLINEAR   0x400u  /* sigma(range)/range > params.nonlinear_rel_sigma: the
+                                       first-order covariance is no longer accurate (near the horizon) */
+
+typedef struct cyl_observe_params {
+    cyl_noise_estimator estimator;              /* centroid variance estimator (default CYL_NOISE_LOCAL) */
+    cyl_geom_model model;                       /* geometric model (default CYL_GEOM_EXACT) */
+    uint8_t class_mask;                         /* bit i: observe blobs of class i (default 0xFF) */
+    uint32_t min_area;                          /* skip blobs with fewer samples (default 1) */
+    double min_var_px2;                         /* floor of each centroid variance, px^2 (default 0) */
+    double nonlinear_rel_sigma;                 /* CYL_OBS_NONLINEAR threshold on sigma_r / r
+                                                   (default 0.055: beyond it Monte Carlo shows the
+                                                   first-order range variance off by > 3%, roughly
+                                                   10 (sigma_r/r)^2; <= 0 disables) */
+    cyl_landmark_size size[CYL_MAX_CLASSES];    /* physical size of each class's landmarks, m
+                                                   (default 0 = unknown) */
+} cyl_observe_params;
+
+typedef struct cyl_observation {
+    uint32_t blob;              /* index of the blob in seg->blobs */
+    uint8_t cls;                /* class index */
+    uint32_t flags;             /* CYL_BLOB_TOUCH_*, CYL_BLOB_MERGED, CYL_OBS_* bits */
+    uint32_t area;              /* samples in the blob */
+    double u_px;                /* measurement point (centroid) column, px */
+    double v_px;                /* measurement point row, px */
+    double var_u_px2;           /* variance of u_px, px^2 */
+    double var_v_px2;           /* variance of v_px, px^2 */
+    double range_m;             /* range from the robot centre, m (0 if CYL_OBS_NO_RANGE) */
+    double bearing_rad;         /* bearing from the robot centre, rad, left positive */
+    double cov_rb[2][2];        /* covariance of (range_m, bearing_rad): m^2, m rad; m rad, rad^2 */
+    double x_m, y_m;            /* landmark in the robot frame (x forward, y left), m */
+    double cov_xy[2][2];        /* covariance of (x_m, y_m), m^2 */
+    double depth_m;             /* depth of the point along the optical axis, m */
+    double w_px, h_px;          /* blob bounding box, px (samples times step) */
+    double w_est_px, h_est_px;  /* expected size of a landmark of the class at depth_m, px */
+    double confidence;          /* eq. 7, 0..1 (0 if cut, no range or no size) */
+    double confidence_uncut;    /* score of the uncut dimensions, 0..1 (cyl_landmark_confidence) */
+} cyl_observation;
+
+/* The defaults above. */
+cyl_observe_params cyl_observe_params_default(void);
+
+/* Workspace bytes cyl_observe() needs for this segmentation and parameters. */
+size_t cyl_observe_work_size(const cyl_segmentation *seg, const cyl_observe_params *p);
+
+/* Observations of the blobs of seg into out[0 .. cap-1]; *n_out receives the count. Returns
+ * CYL_OK, CYL_TRUNCATED (more blobs than cap: the first cap are filled), CYL_ERR_ARG,
+ * CYL_ERR_CAMERA (cyl_camera_check failed) or CYL_ERR_NOMEM (work too small). */
+cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
+                       const cyl_observe_params *p, void *work, size_t work_size,
+                       cyl_observation *out, uint32_t cap, uint32_t *n_out);
+
+/* Error budget (Tables 8, 9) of one observation made with camera cam and model. */
+cyl_status cyl_observation_budget(const cyl_observation *obs, const cyl_camera *cam,
+                                  cyl_geom_model model, cyl_error_budget *b);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* CYL_OBSERVE_H */

@@ -1,0 +1,105 @@
+/* libcyl -- blobs to observations. */
+#include "cyl/observe.h"
+#include "unc_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+cyl_observe_params cyl_observe_params_default(void)
+{
+    cyl_observe_params p;
+    memset(&p, 0, sizeof p);
+    p.estimator = CYL_NOISE_LOCAL;
+    p.model = CYL_GEOM_EXACT;
+    p.class_mask = 0xFFu;
+    p.min_area = 1;
+    p.min_var_px2 = 0.0;
+    p.nonlinear_rel_sigma = 0.055;
+    return p;
+}
+
+size_t cyl_observe_work_size(const cyl_segmentation *seg, const cyl_observe_params *p)
+{
+    if (!p || p->estimator != CYL_NOISE_COLUMN) return 0;
+    return cyl_noise_work_size_seg(seg);
+}
+
+cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
+                       const cyl_observe_params *p, void *work, size_t work_size,
+                       cyl_observation *out, uint32_t cap, uint32_t *n_out)
+{
+    uint32_t bi, n = 0;
+    cyl_status st, ret = CYL_OK;
+    if (!seg || !cam || !p || !n_out || (cap > 0 && !out)) return CYL_ERR_ARG;
+    *n_out = 0;
+    if (seg->n_blobs > 0 && !seg->blobs) return CYL_ERR_ARG;
+    st = cyl_camera_check(cam);
+    if (st != CYL_OK) return st;
+    if (work_size < cyl_observe_work_size(seg, p)) return CYL_ERR_NOMEM;
+    if (p->model != CYL_GEOM_EXACT && p->model != CYL_GEOM_PAPER) return CYL_ERR_ARG;
+    if (!(p->min_var_px2 >= 0.0)) return CYL_ERR_ARG;
+    for (bi = 0; bi < seg->n_blobs; bi++) {
+        const cyl_blob *b = &seg->blobs[bi];
+        cyl_observation *o;
+        cyl_centroid_noise cn;
+        cyl_rb_result rb;
+        if (b->cls >= CYL_MAX_CLASSES || !(p->class_mask & (1u << b->cls))) continue;
+        if (b->area < p->min_area) continue;
+        if (n == cap) { ret = CYL_TRUNCATED; break; }
+        st = cyl_noise_blob(seg, b, p->estimator, work, work_size, &cn);
+        if (st == CYL_ERR_EMPTY) continue;
+        if (st != CYL_OK) return st;
+        o = &out[n++];
+        memset(o, 0, sizeof *o);
+        o->blob = bi;
+        o->cls = b->cls;
+        o->flags = b->flags & (CYL_BLOB_TOUCH_ANY | CYL_BLOB_MERGED);
+        if (b->flags & CYL_BLOB_TOUCH_ANY) o->flags |= CYL_OBS_CUT;
+        o->area = cn.n;
+        o->u_px = cn.cx_px;
+        o->v_px = cn.cy_px;
+        o->var_u_px2 = cn.var_x_px2 > p->min_var_px2 ? cn.var_x_px2 : p->min_var_px2;
+        o->var_v_px2 = cn.var_y_px2 > p->min_var_px2 ? cn.var_y_px2 : p->min_var_px2;
+        o->w_px = (double)cn.box_w * (double)seg->x_step;
+        o->h_px = (double)cn.box_h * (double)seg->y_step;
+        st = cyl_rb_compute(cam, p->model, o->u_px, o->v_px, o->var_u_px2, o->var_v_px2, 0.0, &rb);
+        if (st == CYL_ERR_NO_RANGE) {
+            o->flags |= CYL_OBS_NO_RANGE;
+            o->bearing_rad = rb.bearing_rad;
+            o->cov_rb[1][1] = rb.cov_rb[1][1];
+            continue;
+        }
+        if (st != CYL_OK) { o->flags |= CYL_OBS_INVALID; continue; }
+        o->range_m = rb.range_m;
+        o->bearing_rad = rb.bearing_rad;
+        memcpy(o->cov_rb, rb.cov_rb, sizeof o->cov_rb);
+        o->x_m = rb.x_m;
+        o->y_m = rb.y_m;
+        memcpy(o->cov_xy, rb.cov_xy, sizeof o->cov_xy);
+        o->depth_m = rb.depth_m;
+        if (p->nonlinear_rel_sigma > 0.0 && sqrt(rb.cov_rb[0][0]) > p->nonlinear_rel_sigma * rb.range_m)
+            o->flags |= CYL_OBS_NONLINEAR;
+        {
+            cyl_confidence c;
+            if (cyl_landmark_confidence(o->w_px, o->h_px, o->depth_m, cam->fx_px, cam->fy_px,
+                                        &p->size[b->cls], b->flags, &c) == CYL_OK) {
+                o->confidence = c.confidence;
+                o->confidence_uncut = c.confidence_uncut;
+                o->w_est_px = c.w_est_px;
+                o->h_est_px = c.h_est_px;
+            } else {
+                o->flags |= CYL_OBS_NO_SIZE;
+            }
+        }
+    }
+    *n_out = n;
+    return ret;
+}
+
+cyl_status cyl_observation_budget(const cyl_observation *obs, const cyl_camera *cam,
+                                  cyl_geom_model model, cyl_error_budget *b)
+{
+    if (!obs || !cam || !b) return CYL_ERR_ARG;
+    return cyl_error_budget_at(cam, model, obs->u_px, obs->v_px, obs->var_u_px2, obs->var_v_px2,
+                               0.0, b);
+}

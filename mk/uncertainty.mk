@@ -1,0 +1,41 @@
+# libcyl uncertainty model (issue 3): C++ calibration loader, the paper tool, OpenCV tests.
+#   make paper       the paper's Tables 6, 8, 9 beside ours; last line JSON
+# Test programs added to `make test`: build/tests/test_undistort_cv, build/tests/test_calibration.
+
+UNC_FE_OBJ := $(BUILD)/unc/calibration.o
+UNC_CV_CFLAGS = $$(pkg-config --cflags opencv4)
+UNC_CV_LIBS = $$(pkg-config --libs opencv4)
+
+$(UNC_FE_OBJ): frontend/src/calibration.cpp frontend/include/cylfe/calibration.hpp \
+		frontend/include/cylfe/error.hpp $(wildcard libcyl/include/cyl/*.h) $(STAMP)/debs-cv
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS_ALL) $(UNC_CV_CFLAGS) -c $< -o $@
+
+$(BUILD)/cyl_paper: frontend/tools/cyl_paper.cpp $(UNC_FE_OBJ) lib
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS_ALL) $(UNC_CV_CFLAGS) $< $(UNC_FE_OBJ) -o $@ $(LIBCYL_A) $(UNC_CV_LIBS) -lm
+
+$(BUILD)/tests/test_undistort_cv: tests/cv/test_undistort_cv.cpp $(UNC_FE_OBJ) lib $(STAMP)/debs-cv
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS_ALL) $(UNC_CV_CFLAGS) -DUNC_CALIB_DIR=\"$(CURDIR)/calib_data\" $< $(UNC_FE_OBJ) -o $@ $(LIBCYL_A) $(UNC_CV_LIBS) \
+	  -lgtest -lgtest_main -pthread -lm
+
+$(BUILD)/tests/test_calibration: tests/cv/test_calibration.cpp $(UNC_FE_OBJ) lib $(STAMP)/debs-cv
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS_ALL) $(UNC_CV_CFLAGS) -DUNC_CALIB_DIR=\"$(CURDIR)/calib_data\" $< $(UNC_FE_OBJ) -o $@ $(LIBCYL_A) $(UNC_CV_LIBS) \
+	  -lgtest -lgtest_main -pthread -lm
+
+TEST_EXTRA += $(BUILD)/tests/test_undistort_cv $(BUILD)/tests/test_calibration
+TEST_EXTRA_BINS += $(BUILD)/tests/test_undistort_cv $(BUILD)/tests/test_calibration
+
+# make bench-uncertainty: cyl_observe time per frame vs cyl_segment (issue 3: <= 10%). Its last
+# line is a JSON fragment meant for scripts/bench.sh's BENCH_EXTRA_JSON.
+$(BUILD)/bench_uncertainty: bench/bench_uncertainty.cpp tests/common/synth_frames.c tests/common/rng.c lib
+	@mkdir -p $(dir $@)
+	$(CC) $(TEST_CFLAGS) -O3 -c tests/common/synth_frames.c -o $(BUILD)/unc_synth_frames.o
+	$(CC) $(TEST_CFLAGS) -O3 -c tests/common/rng.c -o $(BUILD)/unc_rng.o
+	$(CXX) $(CXXFLAGS_ALL) -O3 $< $(BUILD)/unc_synth_frames.o $(BUILD)/unc_rng.o -o $@ $(LIBCYL_A) -lm
+
+.PHONY: bench-uncertainty
+bench-uncertainty: $(BUILD)/bench_uncertainty
+	@$(BUILD)/bench_uncertainty

@@ -1,0 +1,245 @@
+/* cyl_observe: blobs to observations, on hand-made segmentations of rendered landmarks and end
+ * to end through cyl_segment on a synthetic frame. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+#include <cmocka.h>
+
+#include "cyl/observe.h"
+#include "cyl/colortable.h"
+#include "rng.h"
+#include "synth_frames.h"
+#include "unc_paper.h"
+
+#define MAXR 8192
+typedef struct hseg {
+    cyl_run runs[MAXR];
+    cyl_blob blobs[8];
+    cyl_segmentation seg;
+} hseg;
+
+static hseg H;
+
+static void hs_init(hseg *h)
+{
+    memset(h, 0, sizeof *h);
+    h->seg.runs = h->runs;
+    h->seg.max_runs = MAXR;
+    h->seg.blobs = h->blobs;
+    h->seg.max_blobs = 8;
+    h->seg.x_step = h->seg.y_step = 1;
+    h->seg.x_last = 767;
+    h->seg.y_last = 575;
+    h->seg.frame_width = 768;
+    h->seg.frame_height = 576;
+}
+
+/* a rectangular blob [x0, x1] x [y0, y1], clipped to the frame (setting touch flags) */
+static void hs_rect(hseg *h, uint8_t cls, int x0, int y0, int x1, int y1)
+{
+    cyl_blob *b = &h->blobs[h->seg.n_blobs];
+    int y;
+    memset(b, 0, sizeof *b);
+    if (x0 <= 0) { x0 = 0; b->flags |= CYL_BLOB_TOUCH_LEFT; }
+    if (y0 <= 0) { y0 = 0; b->flags |= CYL_BLOB_TOUCH_TOP; }
+    if (x1 >= 767) { x1 = 767; b->flags |= CYL_BLOB_TOUCH_RIGHT; }
+    if (y1 >= 575) { y1 = 575; b->flags |= CYL_BLOB_TOUCH_BOTTOM; }
+    b->cls = cls;
+    b->first_run = h->seg.n_runs;
+    b->x0 = (uint16_t)x0; b->x1 = (uint16_t)x1; b->y0 = (uint16_t)y0; b->y1 = (uint16_t)y1;
+    for (y = y0; y <= y1; y++) {
+        cyl_run *r = &h->runs[h->seg.n_runs];
+        r->x = (uint16_t)x0;
+        r->y = (uint16_t)y;
+        r->width = (uint16_t)(x1 - x0 + 1);
+        r->cls = cls;
+        r->blob = h->seg.n_blobs;
+        r->next = y < y1 ? h->seg.n_runs + 1 : CYL_NONE;
+        h->seg.n_runs++;
+        b->area += r->width;
+        b->n_runs++;
+    }
+    h->seg.n_blobs++;
+}
+
+/* render a landmark of diameter D, height Hm at robot-frame (x, y) as a rectangle */
+static void render(hseg *h, const cyl_camera *cam, uint8_t cls, double x, double y, double D,
+                   double Hm)
+{
+    double u, v, w, hh;
+    cyl_rb_result r;
+    assert_int_equal(cyl_rb_project(cam, x, y, &u, &v), CYL_OK);
+    assert_int_equal(cyl_range_bearing(cam, CYL_GEOM_EXACT, u, v, 0, 0, 0, &r), CYL_OK);
+    w = cam->fx_px * D / r.depth_m;
+    hh = cam->fy_px * Hm / r.depth_m;
+    /* pixel k covers [k - 0.5, k + 0.5]: the pixels inside [u - w/2, u + w/2] */
+    hs_rect(h, cls, (int)lround(u - w / 2 + 0.5), (int)lround(v - hh / 2 + 0.5),
+            (int)lround(u + w / 2 - 0.5), (int)lround(v + hh / 2 - 0.5));
+}
+
+static void test_rendered_landmarks(void **st)
+{
+    cyl_camera cam;
+    cyl_observe_params p = cyl_observe_params_default();
+    cyl_observation obs[8];
+    uint32_t n;
+    int i;
+    static const double pos[3][2] = {{1.5, 0.2}, {1.8, -0.3}, {2.2, 0.5}};
+    (void)st;
+    unc_paper_camera(&cam);
+    hs_init(&H);
+    for (i = 0; i < 3; i++) render(&H, &cam, (uint8_t)i, pos[i][0], pos[i][1], 0.16, 0.30);
+    p.size[0].diameter_m = p.size[1].diameter_m = p.size[2].diameter_m = 0.16;
+    p.size[0].height_m = p.size[1].height_m = p.size[2].height_m = 0.30;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_int_equal(n, 3);
+    for (i = 0; i < 3; i++) {
+        cyl_centroid_noise cn;
+        cyl_rb_result r;
+        double tr = hypot(pos[i][0], pos[i][1]), tb = atan2(pos[i][1], pos[i][0]);
+        assert_int_equal(obs[i].cls, i);
+        /* the farthest (2.26 m) has sigma_r/r > 0.055: first-order covariance flagged */
+        assert_int_equal(obs[i].flags, i == 2 ? CYL_OBS_NONLINEAR : 0);
+        /* rectangle corners rounded to whole px: centroid within 0.5 px of the true point */
+        assert_true(fabs(obs[i].range_m - tr) < 0.01);
+        assert_true(fabs(obs[i].bearing_rad - tb) < 1e-3);
+        assert_true(obs[i].confidence > 0.9 && obs[i].confidence <= 1.0);
+        /* consistent with the building blocks */
+        assert_int_equal(cyl_noise_blob(&H.seg, &H.blobs[i], CYL_NOISE_LOCAL, NULL, 0, &cn), CYL_OK);
+        assert_true(obs[i].var_u_px2 == cn.var_x_px2 && obs[i].var_v_px2 == cn.var_y_px2);
+        assert_int_equal(cyl_range_bearing(&cam, CYL_GEOM_EXACT, cn.cx_px, cn.cy_px, cn.var_x_px2,
+                                           cn.var_y_px2, 0, &r), CYL_OK);
+        assert_memory_equal(obs[i].cov_rb, r.cov_rb, sizeof r.cov_rb);
+        assert_memory_equal(obs[i].cov_xy, r.cov_xy, sizeof r.cov_xy);
+        assert_true(obs[i].cov_rb[0][0] > 0 && obs[i].cov_rb[1][1] > 0);
+    }
+    /* error budget of an observation */
+    {
+        cyl_error_budget b;
+        assert_int_equal(cyl_observation_budget(&obs[0], &cam, CYL_GEOM_EXACT, &b), CYL_OK);
+        assert_true(b.share_range[CYL_SRC_TILT] > 0.95);
+        assert_true(fabs(b.total_var_range_m2 - obs[0].cov_rb[0][0]) < 1e-15);
+    }
+    /* class mask, truncation, missing size */
+    p.class_mask = 0x6;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_int_equal(n, 2);
+    assert_int_equal(obs[0].cls, 1);
+    p.class_mask = 0xFF;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 2, &n), CYL_TRUNCATED);
+    assert_int_equal(n, 2);
+    p.size[2].diameter_m = 0;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(obs[2].flags & CYL_OBS_NO_SIZE);
+    assert_true(obs[2].confidence == 0.0);
+    /* the column estimator needs its workspace */
+    p.estimator = CYL_NOISE_COLUMN;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_ERR_NOMEM);
+    {
+        size_t ws = cyl_observe_work_size(&H.seg, &p);
+        void *w = malloc(ws);
+        assert_true(ws >= 768 * sizeof(int32_t));
+        assert_int_equal(cyl_observe(&H.seg, &cam, &p, w, ws, obs, 8, &n), CYL_OK);
+        assert_int_equal(n, 3);
+        free(w);
+    }
+    /* invalid camera */
+    cam.fx_px = 0;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_ERR_CAMERA);
+}
+
+static void test_flags(void **st)
+{
+    cyl_camera cam;
+    cyl_observe_params p = cyl_observe_params_default();
+    cyl_observation obs[8];
+    uint32_t n;
+    (void)st;
+    unc_paper_camera(&cam);
+    p.size[0].diameter_m = 0.16;
+    p.size[0].height_m = 0.30;
+    hs_init(&H);
+    hs_rect(&H, 0, -5, 300, 20, 360);     /* cut on the left */
+    hs_rect(&H, 0, 400, 100, 420, 160);   /* above the horizon (row < 278.8 - 872.4 tan 1.656 deg) */
+    hs_rect(&H, 0, 400, 262, 420, 266);   /* just below the horizon: far, nonlinear */
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_int_equal(n, 3);
+    assert_true(obs[0].flags & CYL_OBS_CUT);
+    assert_true(obs[0].flags & CYL_BLOB_TOUCH_LEFT);
+    assert_true(obs[0].confidence == 0.0 && obs[0].range_m > 0);
+    assert_true(obs[1].flags & CYL_OBS_NO_RANGE);
+    assert_true(obs[1].range_m == 0.0 && obs[1].cov_rb[0][0] == 0.0 && obs[1].cov_rb[1][1] > 0.0);
+    assert_true(obs[1].confidence == 0.0);
+    assert_false(obs[2].flags & CYL_OBS_NO_RANGE);
+    assert_true(obs[2].flags & CYL_OBS_NONLINEAR);
+    assert_true(obs[2].range_m > 10.0);
+}
+
+/* End to end: a rectangle drawn in a synthetic frame, segmented by cyl_segment, observed. */
+static void test_end_to_end(void **st)
+{
+    static cyl_colortable t;
+    cyl_camera cam;
+    canvas c;
+    cyl_segment_params sp = cyl_segment_params_default();
+    cyl_segmentation seg;
+    cyl_observe_params p = cyl_observe_params_default();
+    cyl_observation obs[4];
+    cyl_image img;
+    uint8_t *buf;
+    void *mem;
+    size_t cap, msz;
+    uint32_t n, maxr;
+    double u, v, w, hh, X = 1.6, Y = -0.25;
+    cyl_rb_result r;
+    (void)st;
+    unc_paper_camera(&cam);
+    assert_int_equal(cyl_rb_project(&cam, X, Y, &u, &v), CYL_OK);
+    assert_int_equal(cyl_range_bearing(&cam, CYL_GEOM_EXACT, u, v, 0, 0, 0, &r), CYL_OK);
+    w = cam.fx_px * 0.16 / r.depth_m;
+    hh = cam.fy_px * 0.30 / r.depth_m;
+    assert_true(canvas_alloc(&c, 768, 576));
+    canvas_fill(&c, 120, 128, 128);
+    {
+        int x0 = (int)lround(u - w / 2 + 0.5), x1 = (int)lround(u + w / 2 - 0.5);
+        int y0 = (int)lround(v - hh / 2 + 0.5), y1 = (int)lround(v + hh / 2 - 0.5);
+        canvas_rect(&c, x0, y0, x1 - x0 + 1, y1 - y0 + 1, 90, 80, 200);
+    }
+    cap = canvas_format_size(&c, CYL_FMT_YUV444P, 0);
+    buf = malloc(cap);
+    assert_true(canvas_to_format(&c, CYL_FMT_YUV444P, 0, 0, buf, cap, &img));
+    cyl_colortable_init(&t);
+    assert_int_equal(cyl_colortable_add_box(&t, 0, 0, 255, 60, 100, 180, 220), CYL_OK);
+    maxr = cyl_segment_max_runs(768, 576, &sp);
+    msz = cyl_segment_mem_size(maxr, 256);
+    mem = malloc(msz);
+    assert_int_equal(cyl_segmentation_init(&seg, mem, msz, maxr, 256), CYL_OK);
+    assert_int_equal(cyl_segment(&t, &img, &sp, &seg), CYL_OK);
+    assert_int_equal(seg.n_blobs, 1);
+    p.size[0].diameter_m = 0.16;
+    p.size[0].height_m = 0.30;
+    assert_int_equal(cyl_observe(&seg, &cam, &p, NULL, 0, obs, 4, &n), CYL_OK);
+    assert_int_equal(n, 1);
+    assert_true(fabs(obs[0].range_m - hypot(X, Y)) < 0.01);
+    assert_true(fabs(obs[0].bearing_rad - atan2(Y, X)) < 1e-3);
+    assert_true(obs[0].confidence > 0.9);
+    assert_true(fabs(obs[0].u_px - seg.blobs[0].cx_px) < 1e-9);
+    assert_true(fabs(obs[0].v_px - seg.blobs[0].cy_px) < 1e-9);
+    free(mem);
+    free(buf);
+    canvas_free(&c);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_rendered_landmarks),
+        cmocka_unit_test(test_flags),
+        cmocka_unit_test(test_end_to_end),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
