@@ -1,0 +1,47 @@
+# slam_demo (cylslam): the Python SLAM back end (issue 7). Included by the top Makefile.
+#   make slam-venv     the project-local venv .venv/ (gtsam==4.3.0, numpy, matplotlib, pytest)
+#   make slam-test     the slam_demo pytest suite (also part of `make test`)
+#   make slam-synth    synthetic log -> SLAM -> plots, metrics, acceptance check (out/slam/synth)
+#   make mrclam        MRCLAM Dataset 7, all 5 robots, known + unknown association (out/slam/mrclam*)
+#   make victoria      gtsam's Victoria Park file (out/slam/victoria)
+#   make slam-run LOG=FILE.jsonl [SLAM_ARGS=...]   SLAM on any observation log (out/slam/<name>)
+# MRCLAM_DIR points at the UTIAS MRCLAM data set (not used by `make test`).
+
+DEBS_PY    := python3-venv python3-pip
+PYTHON3    ?= python3
+VENV       := .venv
+VENV_PY    := $(VENV)/bin/python
+MRCLAM_DIR ?= ../shared/data/mrclam/MRCLAM_Dataset7
+SLAM_OUT   ?= out/slam
+CYLSLAM    := PYTHONPATH=slam_demo $(VENV_PY) -m cylslam
+
+$(VENV)/.stamp: slam_demo/requirements.txt $(STAMP)/debs-py
+	$(PYTHON3) -m venv $(VENV)
+	$(VENV)/bin/pip install -q -r slam_demo/requirements.txt
+	touch $@
+
+TEST_EXTRA += $(VENV)/.stamp
+TEST_EXTRA_BINS += pytest:slam_demo/run_tests.sh
+
+.PHONY: slam-venv slam-test slam-synth mrclam victoria slam-run
+slam-venv: $(VENV)/.stamp
+
+slam-test: $(VENV)/.stamp
+	$(VENV_PY) -m pytest -q -p no:cacheprovider slam_demo/tests
+
+slam-synth: $(VENV)/.stamp
+	@mkdir -p $(SLAM_OUT)
+	$(CYLSLAM) synth $(SLAM_OUT)/synth.jsonl --frames 1200 --seed 7
+	$(CYLSLAM) run $(SLAM_OUT)/synth.jsonl --out $(SLAM_OUT)/synth --check
+
+mrclam: $(VENV)/.stamp
+	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc known --out $(SLAM_OUT)/mrclam-known \
+	  --check-rmse 0.15 --check-time 30
+	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc unknown --odom-scale 4 --out $(SLAM_OUT)/mrclam-unknown
+
+victoria: $(VENV)/.stamp
+	$(CYLSLAM) victoria --out $(SLAM_OUT)/victoria
+
+slam-run: $(VENV)/.stamp
+	@test -n "$(LOG)" || { echo "usage: make slam-run LOG=FILE.jsonl [SLAM_ARGS=...]"; exit 2; }
+	$(CYLSLAM) run $(LOG) --out $(SLAM_OUT)/$(basename $(notdir $(LOG))) $(SLAM_ARGS)

@@ -1,0 +1,379 @@
+"""The GTSAM back end: Pose2 chain, one BearingRangeFactor2D per observation with its own
+covariance, iSAM2 incrementally, a final batch Levenberg-Marquardt pass, data association.
+
+Conventions
+- Our observations are (range, bearing) with a 2x2 covariance in that order. GTSAM's
+  BearingRange measurement is (bearing, range), so the covariance handed to GTSAM is
+  P C P with P = [[0, 1], [1, 0]] (`to_gtsam_cov`).
+- Pose2 tangent coordinates are (vx, vy, omega) in the body frame (GTSAM's local coordinates);
+  the Jacobians below use them.
+- Gauge: the first pose gets a tight prior (sigmas 1e-3 m, 1e-3 m, 1e-4 rad) at the true start pose
+  when the data has one (`anchor="truth"`, the only use of truth in estimation: it fixes the
+  world frame so that estimates and their covariances can be compared with truth), else at the
+  origin.
+
+Data association (`assoc="unknown"`): per frame, for the usable observations (flags & 0x320 == 0,
+a range, confidence >= conf_min): candidates are landmarks of the same class whose estimate lies
+within `cand_radius` m of the observation's predicted world position. For the frame's current pose
+and all candidates one iSAM2 joint marginal covariance Sigma is computed; each (observation,
+candidate) pair gets the innovation nu = z - h(x, l) and S = H Sigma H^T + R, and
+d2 = nu^T S^-1 nu. Pairs with d2 <= chi2_2(gate_p) may associate; an optimal assignment
+(Hungarian, minimum total d2, at most one observation per landmark) decides, with a "no landmark"
+option of cost chi2_2(gate_p) per observation. An unassigned observation starts a new landmark if
+its smallest d2 over its candidates exceeds chi2_2(new_p) (or it has no candidate)
+and its largest planar standard deviation is <= init_max_sigma (0.5 m: a near-horizon blob with a
+range sigma of metres must not seed a landmark; it may still update one); otherwise it is dropped
+(ambiguous / imprecise, counted). The candidate radius is cand_radius + 3 sigma of the
+observation, keeping the `max_cands` (4) nearest. Known association (`assoc="known"`) uses the identities in
+the data instead.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Optional
+
+import gtsam
+import numpy as np
+
+from .data import FLAG_NO_RANGE, FLAGS_REJECT, compose, rb_to_world, wrap
+
+PERM = np.array([[0.0, 1.0], [1.0, 0.0]])
+
+
+def X(i):
+    return gtsam.symbol("x", i)
+
+
+def L(j):
+    return gtsam.symbol("l", j)
+
+
+def to_gtsam_cov(cov_rb):
+    """(range, bearing) covariance -> GTSAM's (bearing, range) order."""
+    return PERM @ np.asarray(cov_rb, float) @ PERM
+
+
+def chi2_2dof(p):
+    """Inverse CDF of chi-square with 2 degrees of freedom (exact)."""
+    return -2.0 * math.log(1.0 - p)
+
+
+def predict_rb(pose, lm):
+    """Predicted (range, bearing) of landmark lm from pose and the 2x5 Jacobian with respect to
+    [pose tangent (vx, vy, omega), landmark (x, y)], rows in (range, bearing) order."""
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    ex, ey = lm[0] - pose[0], lm[1] - pose[1]
+    dx, dy = c * ex + s * ey, -s * ex + c * ey
+    r2 = dx * dx + dy * dy
+    r = math.sqrt(r2)
+    b = math.atan2(dy, dx)
+    drb_dd = np.array([[dx / r, dy / r], [-dy / r2, dx / r2]])
+    dd = np.array([[-1.0, 0.0, dy, c, s], [0.0, -1.0, -dx, -s, c]])
+    return np.array([r, b]), drb_dd @ dd
+
+
+def hungarian(cost):
+    """Minimum-cost assignment of rows to distinct columns (rows <= cols). Returns col per row."""
+    cost = np.asarray(cost, float)
+    n, m = cost.shape
+    assert n <= m
+    INF = float("inf")
+    u = [0.0] * (n + 1)
+    v = [0.0] * (m + 1)
+    p = [0] * (m + 1)
+    way = [0] * (m + 1)
+    for i in range(1, n + 1):
+        p[0] = i
+        j0 = 0
+        minv = [INF] * (m + 1)
+        used = [False] * (m + 1)
+        while True:
+            used[j0] = True
+            i0 = p[j0]
+            delta = INF
+            j1 = -1
+            for j in range(1, m + 1):
+                if not used[j]:
+                    cur = cost[i0 - 1, j - 1] - u[i0] - v[j]
+                    if cur < minv[j]:
+                        minv[j] = cur
+                        way[j] = j0
+                    if minv[j] < delta:
+                        delta = minv[j]
+                        j1 = j
+            for j in range(m + 1):
+                if used[j]:
+                    u[p[j]] += delta
+                    v[j] -= delta
+                else:
+                    minv[j] -= delta
+            j0 = j1
+            if p[j0] == 0:
+                break
+        while True:
+            j1 = way[j0]
+            p[j0] = p[j1]
+            j0 = j1
+            if j0 == 0:
+                break
+    ans = [-1] * n
+    for j in range(1, m + 1):
+        if p[j]:
+            ans[p[j] - 1] = j - 1
+    return ans
+
+
+@dataclass
+class Params:
+    assoc: str = "auto"            # auto (known if the data has identities) | known | unknown
+    conf_min: float = 0.5          # drop observations with confidence below this
+    gate_p: float = 0.99           # association gate, chi-square 2 dof
+    new_p: float = 0.9999          # a new landmark only when every landmark is beyond this
+    cand_radius: float = 2.0       # m, Euclidean pre-selection of candidates (+ 3 sigma of the obs)
+    init_max_sigma: float = 0.5    # m, no new landmark from an observation less precise than this
+    max_cands: int = 4             # at most this many nearest candidates per observation
+    reject_flags: int = FLAGS_REJECT  # obs.flags bits that drop an observation (format: 0x320)
+    robust: str = "none"           # none | huber
+    huber_k: float = 1.345         # Huber threshold on the whitened residual
+    fixed_cov: Optional[np.ndarray] = None   # replaces every observation covariance (r, b order)
+    anchor: str = "truth"          # truth | origin
+    prior_sigmas: tuple = (1e-3, 1e-3, 1e-4)
+    update_every: int = 10         # iSAM2 update at least every N steps (and every observed one)
+    batch: bool = True             # final batch Levenberg-Marquardt
+    covariances: bool = True       # compute marginals after the batch pass
+
+
+@dataclass
+class Result:
+    poses: np.ndarray                     # (N, 3) final estimate
+    pose_cov: Optional[np.ndarray]        # (N, 3, 3) or None
+    isam_poses: np.ndarray                # (N, 3) iSAM2 estimate before the batch pass
+    lms: np.ndarray                       # (M, 2)
+    lm_cov: Optional[np.ndarray]          # (M, 2, 2)
+    lm_class: list
+    lm_ids: list                          # known identity per landmark (or None)
+    assoc: list                           # (step index, Obs, landmark index) per used observation
+    stats: dict = field(default_factory=dict)
+
+
+class Slam:
+    def __init__(self, params: Params, progress=None):
+        self.p = params
+        self.progress = progress
+
+    def _obs_noise(self, cov_rb):
+        g = gtsam.noiseModel.Gaussian.Covariance(to_gtsam_cov(cov_rb))
+        if self.p.robust == "huber":
+            return gtsam.noiseModel.Robust.Create(gtsam.noiseModel.mEstimator.Huber.Create(self.p.huber_k), g)
+        if self.p.robust != "none":
+            raise ValueError(f"unknown robust kernel {self.p.robust!r}")
+        return g
+
+    def run(self, ds) -> Result:
+        p = self.p
+        t0 = time.perf_counter()
+        mode = p.assoc
+        if mode == "auto":
+            mode = "known" if ds.known_ids else "unknown"
+        if mode == "known" and not ds.known_ids:
+            raise ValueError("known association requested but the observations carry no identities")
+        steps = ds.steps
+        n = len(steps)
+        isam_params = gtsam.ISAM2Params()
+        isam = gtsam.ISAM2(isam_params)
+        graph = gtsam.NonlinearFactorGraph()       # everything, for the batch pass
+        new_f = gtsam.NonlinearFactorGraph()
+        new_v = gtsam.Values()
+        if p.anchor == "truth" and steps[0].truth is not None:
+            start = np.array(steps[0].truth, float)
+        else:
+            start = np.zeros(3)
+        f = gtsam.PriorFactorPose2(X(0), gtsam.Pose2(*start),
+                                   gtsam.noiseModel.Diagonal.Sigmas(np.array(p.prior_sigmas)))
+        graph.add(f)
+        new_f.add(f)
+        new_v.insert(X(0), gtsam.Pose2(*start))
+        cur = start.copy()                  # current estimate of the newest pose
+        lms_init = []                       # initial/latest estimate per landmark
+        lm_class, lm_ids = [], []
+        id_to_lm = {}
+        by_class = {}
+        assoc = []
+        st = dict(obs_total=0, dropped_flags=0, dropped_no_range=0, dropped_confidence=0,
+                  dropped_ambiguous=0, dropped_imprecise=0, used=0, new_landmarks=0, isam_updates=0,
+                  marginal_calls=0, association=mode)
+        last_update = 0
+        gate = chi2_2dof(p.gate_p)
+        new_thr = chi2_2dof(p.new_p)
+        for i, s in enumerate(steps):
+            if self.progress:
+                self.progress(i + 1, n)
+            if i > 0:
+                if s.odom is None:
+                    raise ValueError(f"step {i} has no odometry")
+                nm = gtsam.noiseModel.Gaussian.Covariance(np.asarray(s.odom_cov, float))
+                f = gtsam.BetweenFactorPose2(X(i - 1), X(i), gtsam.Pose2(*s.odom), nm)
+                graph.add(f)
+                new_f.add(f)
+                cur = compose(cur, s.odom)
+                new_v.insert(X(i), gtsam.Pose2(*cur))
+            usable = []
+            for o in s.obs:
+                st["obs_total"] += 1
+                if o.flags & p.reject_flags:
+                    st["dropped_flags"] += 1
+                elif (o.flags & FLAG_NO_RANGE) or o.range_m <= 0:
+                    st["dropped_no_range"] += 1
+                elif o.confidence < p.conf_min:
+                    st["dropped_confidence"] += 1
+                else:
+                    usable.append(o)
+            need = bool(usable) and mode == "unknown"
+            if need or i - last_update >= p.update_every or i == n - 1:
+                isam.update(new_f, new_v)
+                st["isam_updates"] += 1
+                new_f = gtsam.NonlinearFactorGraph()
+                new_v = gtsam.Values()
+                last_update = i
+                e = isam.calculateEstimatePose2(X(i))
+                cur = np.array([e.x(), e.y(), e.theta()])
+            if not usable:
+                continue
+            covs = [p.fixed_cov if p.fixed_cov is not None else o.cov for o in usable]
+            if mode == "known":
+                # identities are given: no gating, and a landmark first seen creates it
+                targets = [id_to_lm.get(o.lm_id, -1) for o in usable]
+            else:
+                targets = self._associate(isam, i, cur, usable, covs, lms_init, lm_class,
+                                          by_class, gate, new_thr, st)
+            for o, c, j in zip(usable, covs, targets):
+                if j == -3:
+                    st["dropped_ambiguous"] += 1
+                    continue
+                if j == -4:
+                    st["dropped_imprecise"] += 1
+                    continue
+                if mode == "known":
+                    j = id_to_lm.get(o.lm_id, -1)   # may have been created earlier this frame
+                if j == -1:
+                    j = len(lms_init)
+                    pos = rb_to_world(cur, o.range_m, o.bearing_rad)
+                    lms_init.append(pos)
+                    lm_class.append(o.cls)
+                    lm_ids.append(o.lm_id)
+                    by_class.setdefault(o.cls, []).append(j)
+                    if mode == "known":
+                        id_to_lm[o.lm_id] = j
+                    new_v.insert(L(j), gtsam.Point2(*pos))
+                    st["new_landmarks"] += 1
+                f = gtsam.BearingRangeFactor2D(X(i), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
+                                               self._obs_noise(c))
+                graph.add(f)
+                new_f.add(f)
+                assoc.append((i, o, j))
+                st["used"] += 1
+        if new_f.size() or new_v.size():
+            isam.update(new_f, new_v)
+            st["isam_updates"] += 1
+        est = isam.calculateEstimate()
+        t_isam = time.perf_counter() - t0
+        isam_poses = _poses(est, n)
+        if p.batch:
+            lp = gtsam.LevenbergMarquardtParams()
+            lp.setMaxIterations(100)
+            opt = gtsam.LevenbergMarquardtOptimizer(graph, est, lp)
+            est = opt.optimize()
+            st["batch_iterations"] = opt.iterations()
+        t_batch = time.perf_counter() - t0 - t_isam
+        poses = _poses(est, n)
+        m = len(lms_init)
+        lms = np.array([[est.atPoint2(L(j))[0], est.atPoint2(L(j))[1]] for j in range(m)]).reshape(m, 2)
+        pose_cov = lm_cov = None
+        if p.covariances:
+            marg = gtsam.Marginals(graph, est)
+            pose_cov = np.array([marg.marginalCovariance(X(i)) for i in range(n)])
+            lm_cov = np.array([marg.marginalCovariance(L(j)) for j in range(m)]).reshape(m, 2, 2)
+        st["t_isam_s"] = round(t_isam, 3)
+        st["t_batch_s"] = round(t_batch, 3)
+        st["t_total_s"] = round(time.perf_counter() - t0, 3)
+        st["n_poses"] = n
+        st["n_landmarks"] = m
+        st["final_error"] = graph.error(est)
+        return Result(poses=poses, pose_cov=pose_cov, isam_poses=isam_poses, lms=lms,
+                      lm_cov=lm_cov, lm_class=lm_class, lm_ids=lm_ids, assoc=assoc, stats=st)
+
+    def _associate(self, isam, i, cur, usable, covs, lms_init, lm_class, by_class, gate,
+                   new_thr, st):
+        """Targets per usable observation: landmark index, -1 new landmark, -3 ambiguous,
+        -4 would start a landmark but is too imprecise (sigma > init_max_sigma)."""
+        zs = [np.array([o.range_m, o.bearing_rad]) for o in usable]
+        cands = []
+        sig = []
+        for o, R in zip(usable, covs):
+            w = rb_to_world(cur, o.range_m, o.bearing_rad)
+            # largest standard deviation of the observation in the plane
+            s_max = math.sqrt(max(R[0, 0], o.range_m ** 2 * R[1, 1]))
+            sig.append(s_max)
+            rad = self.p.cand_radius + 3.0 * s_max
+            cs = []
+            for j in by_class.get(o.cls, []):
+                lp = lms_init[j]
+                dd = math.hypot(lp[0] - w[0], lp[1] - w[1])
+                if dd <= rad:
+                    cs.append((dd, j))
+            cands.append([j for _, j in sorted(cs)[:self.p.max_cands]])
+        allc = sorted({j for cs in cands for j in cs})
+        if not allc:
+            return [-1 if s <= self.p.init_max_sigma else -4 for s in sig]
+        keys = [X(i)] + [L(j) for j in allc]
+        jm = isam.jointMarginalCovariance(keys)
+        st["marginal_calls"] += 1
+        Sxx = jm.at(X(i), X(i))
+        lm_est = {}
+        blocks = {}
+        for j in allc:
+            pt = isam.calculateEstimatePoint2(L(j))
+            lm_est[j] = np.array([pt[0], pt[1]])
+            lms_init[j] = lm_est[j]
+            blocks[j] = (jm.at(X(i), L(j)), jm.at(L(j), L(j)))
+        col = {j: k for k, j in enumerate(allc)}
+        nobs, ncand = len(usable), len(allc)
+        BIG = 1e9
+        cost = np.full((nobs, ncand + nobs), BIG)
+        d2min = np.full(nobs, np.inf)
+        for a, (o, z, cs) in enumerate(zip(usable, zs, cands)):
+            R = covs[a]
+            for j in cs:
+                h, H = predict_rb(cur, lm_est[j])
+                Sxl, Sll = blocks[j]
+                Sig = np.block([[Sxx, Sxl], [Sxl.T, Sll]])
+                S = H @ Sig @ H.T + R
+                nu = z - h
+                nu[1] = wrap(nu[1])
+                d2 = float(nu @ np.linalg.solve(S, nu))
+                d2min[a] = min(d2min[a], d2)
+                if d2 <= gate:
+                    cost[a, col[j]] = d2
+            cost[a, ncand + a] = gate
+        sol = hungarian(cost)
+        out = []
+        for a, c in enumerate(sol):
+            if c < ncand and cost[a, c] < BIG:
+                out.append(allc[c])
+            elif d2min[a] <= new_thr:
+                out.append(-3)
+            elif sig[a] > self.p.init_max_sigma:
+                out.append(-4)
+            else:
+                out.append(-1)
+        return out
+
+
+def _poses(values, n):
+    out = np.empty((n, 3))
+    for i in range(n):
+        q = values.atPose2(X(i))
+        out[i] = (q.x(), q.y(), q.theta())
+    return out

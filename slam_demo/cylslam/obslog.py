@@ -1,0 +1,328 @@
+"""Reader and writer of the observation log (docs/formats.md, `cyl-observations` version 1).
+
+Malformed lines. Default (strict): the reader stops at the first malformed line and raises
+ObsLogError("FILE:LINE: reason"); nothing is estimated from a log that is not understood.
+With skip_bad=True it skips each malformed line, keeps going, and reports how many it skipped and
+where (Dataset.notes, printed in the summary): nothing is dropped silently either way.
+Always tolerated: a last line without its newline that does not parse (an interrupted writer,
+the format promises every *complete* record survives) -- reported, not used; blank lines;
+records of an unknown `type` (skipped by the format's rule, counted in the notes); null
+(non-finite) range/covariance fields on observations flagged no-range (0x100) or invalid (0x200),
+which are never used.
+
+A line is malformed when it is not a JSON object, lacks a required field, has a field of the
+wrong type or a non-finite number, has a covariance that is not symmetric positive (semi-)definite,
+or belongs to another frame than the `frame` line before it.
+
+Frames become steps: each `frame` with an `odom` line is one pose; the first frame is the start
+pose (its odom line, if any, has no previous pose and is ignored); the observations of a later
+frame without `odom` are attached to the previous pose (counted in the notes).
+
+Optional field (a proposed extension of the format): `"landmark_id": int` on an `obs` line for
+sources that know identities; when every usable observation has one the back end may use known
+association.
+"""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+from .data import FLAG_INVALID, FLAG_NO_RANGE, Dataset, Obs, Step
+
+FORMAT = "cyl-observations"
+VERSION = 1
+
+
+class ObsLogError(Exception):
+    """A malformed observation log: message starts with FILE:LINE."""
+
+
+def _num(rec, key, where, required=True, default=None):
+    if key not in rec:
+        if required:
+            raise ObsLogError(f"{where}: missing field '{key}'")
+        return default
+    v = rec[key]
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise ObsLogError(f"{where}: field '{key}' must be a number, got {json.dumps(v)}")
+    if not math.isfinite(v):
+        raise ObsLogError(f"{where}: field '{key}' is not finite")
+    return float(v)
+
+
+def _num_or_nan(rec, key, where):
+    if key in rec and rec[key] is None:
+        return float("nan")
+    return _num(rec, key, where)
+
+
+def _int(rec, key, where, required=True, default=None):
+    if key not in rec:
+        if required:
+            raise ObsLogError(f"{where}: missing field '{key}'")
+        return default
+    v = rec[key]
+    if isinstance(v, bool) or not isinstance(v, int):
+        raise ObsLogError(f"{where}: field '{key}' must be an integer, got {json.dumps(v)}")
+    return v
+
+
+def _str(rec, key, where):
+    v = rec.get(key)
+    if not isinstance(v, str) or not v:
+        raise ObsLogError(f"{where}: field '{key}' must be a non-empty string")
+    return v
+
+
+def _check_cov(m, where, what):
+    if not np.allclose(m, m.T):
+        raise ObsLogError(f"{where}: {what} covariance is not symmetric")
+    ev = np.linalg.eigvalsh(m)
+    if ev.min() < -1e-12 * max(1.0, ev.max()):
+        raise ObsLogError(f"{where}: {what} covariance is not positive semi-definite "
+                          f"(eigenvalues {ev.tolist()})")
+
+
+class _Builder:
+    def __init__(self, path):
+        self.path = path
+        self.steps = []
+        self.truth_lm = {}
+        self.cur = None          # dict of the frame being read
+        self.n_no_odom = 0
+        self.n_first_odom = 0
+        self.unknown_types = {}
+
+    def flush_frame(self):
+        f = self.cur
+        if f is None:
+            return
+        self.cur = None
+        if f["n_obs"] is not None and not f["had_skips"] and f["n_obs"] != len(f["obs"]):
+            raise ObsLogError(f"{self.path}:{f['line']}: frame seq {f['seq']} announces "
+                              f"n_obs={f['n_obs']} but {len(f['obs'])} obs lines follow")
+        if not self.steps:
+            if f["odom"] is not None:
+                self.n_first_odom += 1
+            self.steps.append(Step(t=f["t"], seq=f["seq"], obs=f["obs"], truth=f["truth"]))
+            return
+        if f["odom"] is None:
+            self.n_no_odom += 1
+            self.steps[-1].obs.extend(f["obs"])
+            return
+        self.steps.append(Step(t=f["t"], seq=f["seq"], odom=f["odom"][0], odom_cov=f["odom"][1],
+                               obs=f["obs"], truth=f["truth"]))
+
+    def _frame_of(self, rec, where, kind):
+        seq = _int(rec, "seq", where)
+        if self.cur is None:
+            raise ObsLogError(f"{where}: '{kind}' line before any 'frame' line")
+        if seq != self.cur["seq"]:
+            raise ObsLogError(f"{where}: '{kind}' line has seq {seq} but the current frame "
+                              f"(line {self.cur['line']}) is seq {self.cur['seq']}")
+        return self.cur
+
+    def record(self, rec, where, lineno):
+        typ = rec.get("type")
+        if typ == "frame":
+            seq = _int(rec, "seq", where)
+            t = _num(rec, "t", where)
+            n_obs = _int(rec, "n_obs", where, required=False)
+            self.flush_frame()
+            if self.steps and seq <= self.steps[-1].seq:
+                raise ObsLogError(f"{where}: frame seq {seq} does not increase "
+                                  f"(previous {self.steps[-1].seq})")
+            self.cur = dict(seq=seq, t=t, n_obs=n_obs, obs=[], odom=None, truth=None,
+                            line=lineno, had_skips=False)
+        elif typ == "obs":
+            # validate completely before touching the frame
+            cls = _str(rec, "class", where)
+            flags = _int(rec, "flags", where, required=False, default=0)
+            unusable = bool(flags & (FLAG_NO_RANGE | FLAG_INVALID))
+            # a no-range / invalid observation may carry null (non-finite) range and covariance
+            # fields (the frontend writes non-finite numbers as null); it is never used
+            nb = _num_or_nan if unusable else _num
+            r = nb(rec, "range_m", where)
+            b = _num(rec, "bearing_rad", where) if not flags & FLAG_INVALID else nb(rec, "bearing_rad", where)
+            crr = nb(rec, "cov_rr", where)
+            crb = nb(rec, "cov_rb", where)
+            cbb = nb(rec, "cov_bb", where)
+            conf = _num(rec, "confidence", where, required=False, default=1.0)
+            lm_id = _int(rec, "landmark_id", where, required=False)
+            if r < 0:
+                raise ObsLogError(f"{where}: negative range_m {r}")
+            if not 0.0 <= conf <= 1.0:
+                raise ObsLogError(f"{where}: confidence {conf} outside [0, 1]")
+            cov = np.array([[crr, crb], [crb, cbb]])
+            if not unusable:
+                _check_cov(cov, where, "range/bearing")
+            fr = self._frame_of(rec, where, "obs")
+            fr["obs"].append(Obs(cls=cls, range_m=r, bearing_rad=b, cov=cov, confidence=conf,
+                                 flags=flags, lm_id=lm_id, where=where))
+        elif typ == "odom":
+            d = np.array([_num(rec, k, where) for k in ("dx_m", "dy_m", "dtheta_rad")])
+            c = rec.get("cov")
+            if (not isinstance(c, list) or len(c) != 6 or
+                    not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                            and math.isfinite(v) for v in c)):
+                raise ObsLogError(f"{where}: field 'cov' must be a list of 6 finite numbers "
+                                  "(xx xy xt yy yt tt)")
+            xx, xy, xt, yy, yt, tt = c
+            cov = np.array([[xx, xy, xt], [xy, yy, yt], [xt, yt, tt]], float)
+            _check_cov(cov, where, "odometry")
+            fr = self._frame_of(rec, where, "odom")
+            if fr["odom"] is not None:
+                raise ObsLogError(f"{where}: second 'odom' line for frame seq {fr['seq']}")
+            # singular is only an error when used (the first frame's odom line is not)
+            if self.steps and np.linalg.eigvalsh(cov).min() <= 0:
+                raise ObsLogError(f"{where}: odometry covariance is singular")
+            fr["odom"] = (d, cov)
+        elif typ == "truth_pose":
+            p = np.array([_num(rec, k, where) for k in ("x_m", "y_m", "theta_rad")])
+            fr = self._frame_of(rec, where, "truth_pose")
+            fr["truth"] = p
+        elif typ == "truth_landmark":
+            i = _int(rec, "id", where)
+            cls = _str(rec, "class", where)
+            x, y = _num(rec, "x_m", where), _num(rec, "y_m", where)
+            if i in self.truth_lm:
+                raise ObsLogError(f"{where}: truth_landmark id {i} given twice")
+            self.truth_lm[i] = (x, y, cls)
+        elif typ == "header":
+            raise ObsLogError(f"{where}: second header line")
+        elif isinstance(typ, str):
+            self.unknown_types[typ] = self.unknown_types.get(typ, 0) + 1
+        else:
+            raise ObsLogError(f"{where}: missing or non-string 'type'")
+
+
+def read_obslog(path, skip_bad=False) -> Dataset:
+    """Read an observation log into a Dataset. Raises ObsLogError (strict) or skips bad lines."""
+    with open(path, "rb") as fh:
+        raw = fh.read()
+    lines = raw.split(b"\n")
+    truncated_tail = bool(lines and lines[-1] != b"")
+    if not truncated_tail:
+        lines = lines[:-1]
+    header = None
+    b = _Builder(path)
+    skipped = []
+    notes = []
+    n = len(lines)
+    for i, bline in enumerate(lines):
+        lineno = i + 1
+        where = f"{path}:{lineno}"
+        last_unterminated = truncated_tail and i == n - 1
+        try:
+            text = bline.decode("utf-8")
+        except UnicodeDecodeError as e:
+            err = ObsLogError(f"{where}: not UTF-8 ({e.reason} at byte {e.start})")
+            if last_unterminated:
+                notes.append(f"ignored the truncated last line {where} (interrupted writer?)")
+                break
+            if skip_bad and header is not None:
+                skipped.append(str(err))
+                if b.cur is not None:
+                    b.cur["had_skips"] = True
+                continue
+            raise err
+        if not text.strip():
+            continue
+        try:
+            try:
+                rec = json.loads(text)
+            except json.JSONDecodeError as e:
+                raise ObsLogError(f"{where}: not valid JSON ({e.msg} at column {e.colno})")
+            if not isinstance(rec, dict):
+                raise ObsLogError(f"{where}: not a JSON object")
+            if header is None:
+                if rec.get("type") != "header":
+                    raise ObsLogError(f"{where}: first line must be the header "
+                                      "(type 'header')")
+                if rec.get("format") != FORMAT:
+                    raise ObsLogError(f"{where}: format {rec.get('format')!r}, expected {FORMAT!r}")
+                if rec.get("version") != VERSION:
+                    raise ObsLogError(f"{where}: unsupported version {rec.get('version')!r} "
+                                      f"(this reader knows version {VERSION})")
+                header = rec
+                continue
+            b.record(rec, where, lineno)
+        except ObsLogError as err:
+            if last_unterminated and not isinstance(err, _Fatal):
+                notes.append(f"ignored the truncated last line {where} (interrupted writer?)")
+                break
+            if skip_bad and header is not None:
+                skipped.append(str(err))
+                if b.cur is not None:
+                    b.cur["had_skips"] = True
+                continue
+            raise
+    if header is None:
+        raise ObsLogError(f"{path}:1: empty log (no header line)")
+    b.flush_frame()
+    if not b.steps:
+        raise ObsLogError(f"{path}: no frames")
+    if skipped:
+        notes.append(f"skipped {len(skipped)} malformed line(s); first: {skipped[0]}")
+        notes.extend(f"  skipped: {s}" for s in skipped[1:10])
+        if len(skipped) > 10:
+            notes.append(f"  ... and {len(skipped) - 10} more")
+    if b.n_no_odom:
+        notes.append(f"{b.n_no_odom} frame(s) without odometry: observations attached to the "
+                     "previous pose")
+    for k, v in sorted(b.unknown_types.items()):
+        notes.append(f"skipped {v} record(s) of unknown type {k!r}")
+    classes = header.get("classes") or sorted({o.cls for s in b.steps for o in s.obs})
+    obs_all = [o for s in b.steps for o in s.obs]
+    known = bool(obs_all) and all(o.lm_id is not None for o in obs_all)
+    ds = Dataset(name=str(header.get("source", path)), steps=b.steps, truth_landmarks=b.truth_lm,
+                 classes=list(classes), notes=notes, known_ids=known)
+    ds.n_skipped = len(skipped)
+    ds.header = header
+    return ds
+
+
+class _Fatal(ObsLogError):
+    pass
+
+
+class ObsLogWriter:
+    """Writes a log line by line, flushing after each frame (as the frontend does)."""
+
+    def __init__(self, path, source, classes, model="synthetic", estimator="synthetic",
+                 camera=None):
+        self.fh = open(path, "w")
+        self._w(dict(type="header", format=FORMAT, version=VERSION, source=source, model=model,
+                     estimator=estimator, classes=list(classes), camera=camera or {}))
+
+    def _w(self, rec):
+        self.fh.write(json.dumps(rec, separators=(",", ":")) + "\n")
+
+    def truth_landmark(self, i, cls, class_id, x, y, diameter=0.1, height=0.3):
+        self._w(dict(type="truth_landmark", id=i, **{"class": cls}, class_id=class_id,
+                     x_m=x, y_m=y, diameter_m=diameter, height_m=height))
+
+    def frame(self, seq, t, obs, odom=None, truth=None):
+        """obs: list of dicts with the obs fields (without type/seq/t)."""
+        self._w(dict(type="frame", seq=seq, t=t, n_obs=len(obs)))
+        for o in obs:
+            self._w(dict(type="obs", seq=seq, t=t, **o))
+        if odom is not None:
+            d, c = odom
+            self._w(dict(type="odom", seq=seq, t=t, dx_m=d[0], dy_m=d[1], dtheta_rad=d[2],
+                         cov=[c[0][0], c[0][1], c[0][2], c[1][1], c[1][2], c[2][2]]))
+        if truth is not None:
+            self._w(dict(type="truth_pose", seq=seq, t=t, x_m=truth[0], y_m=truth[1],
+                         theta_rad=truth[2]))
+        self.fh.flush()
+
+    def close(self):
+        self.fh.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *a):
+        self.close()

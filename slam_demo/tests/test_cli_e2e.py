@@ -1,0 +1,86 @@
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from conftest import FIXTURES, HERE
+from cylslam import backend, metrics
+from cylslam.obslog import read_obslog
+
+SHORT = os.path.join(FIXTURES, "synth_short.jsonl")
+ENV = dict(os.environ, PYTHONPATH=os.path.dirname(HERE))
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "cylslam", *args], capture_output=True,
+                          text=True, env=ENV, timeout=120)
+
+
+@pytest.mark.parametrize("cmd", ["run", "synth", "mrclam", "victoria", "excerpt"])
+def test_help(cmd):
+    r = _cli(cmd, "--help")
+    assert r.returncode == 0 and "usage:" in r.stdout
+
+
+def test_synthetic_end_to_end_unknown_association():
+    ds = read_obslog(SHORT)
+    res = backend.Slam(backend.Params(assoc="unknown")).run(ds)
+    m = metrics.evaluate(ds, res)
+    assert m["association_errors"] == 0
+    assert m["landmarks_matched"] == m["landmarks_estimated"]
+    assert m["clutter_used"] == 0
+    assert res.stats["dropped_confidence"] > 0 and res.stats["dropped_flags"] > 0
+    assert m["ate_m"] < 0.05 and m["landmark_rmse_m"] < 0.25
+    assert m["ate_m"] < m["ate_isam_m"] + 0.01
+    assert 0.3 < m["anees_poses"] < 3.0
+
+
+def test_cli_run_writes_outputs_and_json_last_line(tmp_path):
+    r = _cli("run", SHORT, "--out", str(tmp_path), "--fixed-cov", "mean")
+    assert r.returncode == 0, r.stderr
+    last = json.loads(r.stdout.strip().splitlines()[-1])
+    for k in ("ate_m", "landmark_rmse_m", "anees_landmarks", "association_errors",
+              "ate_fixed_cov_m"):
+        assert last[k] is not None
+    for f in ("trajectory.csv", "landmarks.csv", "summary.json", "plot.png"):
+        assert os.path.getsize(tmp_path / f) > 0
+    traj = np.genfromtxt(tmp_path / "trajectory.csv", delimiter=",", names=True)
+    assert len(traj) == 300
+
+
+def test_cli_malformed_exit_code_and_message(tmp_path):
+    mal = os.path.join(FIXTURES, "malformed.jsonl")
+    r = _cli("run", mal, "--no-plot", "--fixed-cov", "none", "--out", "/dev/null/x")
+    assert r.returncode == 3
+    assert f"{mal}:7: not valid JSON" in r.stderr
+    r = _cli("run", mal, "--skip-bad", "--no-plot", "--fixed-cov", "none", "--out", str(tmp_path))
+    assert r.returncode == 0, r.stderr
+    assert "skipped 5 malformed line(s)" in r.stdout
+    assert json.loads(r.stdout.strip().splitlines()[-1])["skipped_lines"] == 5
+
+
+def test_cli_missing_file():
+    r = _cli("run", "/nonexistent/log.jsonl")
+    assert r.returncode == 3 and "/nonexistent/log.jsonl" in r.stderr
+
+
+def test_victoria_reader():
+    from cylslam.victoria import read_victoria
+    ds = read_victoria(max_poses=300)
+    assert len(ds.steps) == 300
+    full = read_victoria()
+    assert len(full.steps) == 6969 and full.n_obs() == 3640
+    assert len({o.lm_id for s in full.steps for o in s.obs}) == 151
+
+
+def test_real_frontend_log_reads_unchanged():
+    """150 frames written by the project's frontend (`cyl detect synthetic:7`), as is."""
+    ds = read_obslog(os.path.join(FIXTURES, "frontend_short.jsonl"))
+    assert len(ds.steps) == 150 and ds.n_obs() == 355 and len(ds.truth_landmarks) == 14
+    res = backend.Slam(backend.Params(assoc="unknown")).run(ds)
+    m = metrics.evaluate(ds, res)
+    assert m["association_errors"] == 0 and m["clutter_used"] == 0
+    assert m["ate_m"] < 0.02 and m["landmark_rmse_m"] < 0.1

@@ -1,0 +1,64 @@
+import math
+
+import numpy as np
+import pytest
+
+from cylslam import metrics
+
+
+def test_rmse_hand_computed():
+    est = np.array([[0.0, 0.0], [3.0, 4.0]])
+    assert metrics.rmse(est, np.zeros((2, 2))) == pytest.approx(math.sqrt(25.0 / 2))
+
+
+def test_se2_alignment_recovers_a_rigid_motion():
+    truth = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 2.0], [-1.0, 1.0]])
+    # est = truth rotated by +90 deg and shifted by (5, -1): est_i = R truth_i + (5, -1)
+    R = np.array([[0.0, -1.0], [1.0, 0.0]])
+    est = truth @ R.T + np.array([5.0, -1.0])
+    un, al, (Ra, t, ang) = metrics.ate(est, truth)
+    assert al == pytest.approx(0.0, abs=1e-12)
+    assert ang == pytest.approx(-math.pi / 2)
+    # unaligned by hand: |R p + (5,-1) - p| for each point
+    d = [math.hypot(*(R @ p + np.array([5.0, -1.0]) - p)) for p in truth]
+    assert un == pytest.approx(math.sqrt(np.mean(np.square(d))))
+
+
+def test_se2_alignment_hand_case_with_residual():
+    # two points, symmetric noise: truth (+-1, 0), est (+-1, +-0.1) -> best angle atan(0.1)
+    # rotates est onto truth direction; residual |est| - 1 along the line
+    truth = np.array([[1.0, 0.0], [-1.0, 0.0]])
+    est = np.array([[1.0, 0.1], [-1.0, -0.1]])
+    un, al, (_, t, ang) = metrics.ate(est, truth)
+    assert ang == pytest.approx(-math.atan(0.1))
+    assert np.allclose(t, 0.0)
+    assert al == pytest.approx(math.hypot(1.0, 0.1) - 1.0)
+    assert un == pytest.approx(0.1)
+
+
+def test_anees_known_answer():
+    errs = [np.array([1.0, 0.0]), np.array([0.0, 2.0]), np.array([0.5, 0.5])]
+    covs = [np.eye(2), np.diag([1.0, 4.0]), np.array([[0.5, 0.0], [0.0, 0.25]])]
+    # NEES: 1, 1, 0.25/0.5 + 0.25/0.25 = 1.5 -> mean 3.5/3, per dimension / 2
+    a, (lo, hi) = metrics.anees(errs, covs)
+    assert a == pytest.approx(3.5 / 3 / 2)
+    # correlated covariance: e = (1, 1), C = [[2, 1], [1, 2]] -> e^T C^-1 e = 2/3
+    assert metrics.nees([1.0, 1.0], [[2.0, 1.0], [1.0, 2.0]]) == pytest.approx(2.0 / 3.0)
+
+
+def test_anees_bounds_match_chi_square_table():
+    # chi2(20): 2.5 % = 9.591, 97.5 % = 34.170 (standard tables); N=10 estimates of dimension 2
+    lo, hi = metrics.anees_bounds(10, 2)
+    assert lo == pytest.approx(9.591 / 20, rel=0.01)
+    assert hi == pytest.approx(34.170 / 20, rel=0.01)
+
+
+def test_anees_is_one_for_a_consistent_monte_carlo():
+    rng = np.random.default_rng(1)
+    C = np.array([[0.04, 0.01], [0.01, 0.02]])
+    Lc = np.linalg.cholesky(C)
+    errs = [Lc @ rng.standard_normal(2) for _ in range(4000)]
+    a, (lo, hi) = metrics.anees(errs, [C] * len(errs))
+    assert lo < a < hi
+    a2, _ = metrics.anees(errs, [C / 4] * len(errs))
+    assert a2 == pytest.approx(4 * a)

@@ -1,0 +1,117 @@
+import json
+import os
+
+import numpy as np
+import pytest
+
+from conftest import FIXTURES
+from cylslam.obslog import ObsLogError, read_obslog
+
+MAL = os.path.join(FIXTURES, "malformed.jsonl")
+
+
+def test_short_synthetic_log_reads_completely():
+    path = os.path.join(FIXTURES, "synth_short.jsonl")
+    ds = read_obslog(path)
+    # independent count straight from the JSON lines
+    recs = [json.loads(l) for l in open(path)]
+    n_frames = sum(r["type"] == "frame" for r in recs)
+    n_obs = sum(r["type"] == "obs" for r in recs)
+    assert len(ds.steps) == n_frames == 300
+    assert ds.n_obs() == n_obs
+    assert len(ds.truth_landmarks) == 16
+    assert ds.classes == ["orange", "green"]
+    assert all(s.truth is not None for s in ds.steps)
+    assert ds.steps[0].odom is None and all(s.odom is not None for s in ds.steps[1:])
+    assert not ds.known_ids and ds.notes == []
+
+
+def test_malformed_strict_names_file_and_line():
+    with pytest.raises(ObsLogError) as e:
+        read_obslog(MAL)
+    assert str(e.value).startswith(f"{MAL}:7: not valid JSON")
+
+
+def test_malformed_skip_counts_every_bad_line():
+    ds = read_obslog(MAL, skip_bad=True)
+    assert ds.n_skipped == 5
+    text = "\n".join(ds.notes)
+    for line in (7, 11, 15, 18, 19):
+        assert f"{MAL}:{line}:" in text
+    assert "truncated last line" in text and f"{MAL}:23" in text
+    assert "unknown type 'future_record'" in text
+    assert "1 frame(s) without odometry" in text
+    # the good observations are all kept: lines 4, 10, 21
+    assert [o.range_m for s in ds.steps for o in s.obs] == [2.0, 1.8, 1.5]
+    assert [s.seq for s in ds.steps] == [0, 1, 2, 3, 5]
+
+
+@pytest.mark.parametrize("line,msg", [
+    ('{"type":"obs","seq":0,"t":0,"class":"orange","range_m":1,"bearing_rad":0,"cov_rr":0.01,'
+     '"cov_rb":0,"cov_bb":1e-4}', "'obs' line before any 'frame' line"),
+    ('{"type":"frame","seq":0,"t":0}\n{"type":"obs","seq":0,"t":0,"class":"orange","range_m":1,'
+     '"bearing_rad":0,"cov_rr":0.01,"cov_rb":0}', "missing field 'cov_bb'"),
+    ('{"type":"frame","seq":0,"t":0,"n_obs":2}\n{"type":"frame","seq":1,"t":0.1}',
+     "announces n_obs=2 but 0 obs lines follow"),
+    ('[1,2,3]', "not a JSON object"),
+    ('{"type":"frame","seq":0,"t":NaN}', "field 't' is not finite"),
+])
+def test_each_malformed_kind(tmp_path, line, msg):
+    p = tmp_path / "bad.jsonl"
+    p.write_text('{"type":"header","format":"cyl-observations","version":1}\n' + line + "\n")
+    with pytest.raises(ObsLogError) as e:
+        read_obslog(str(p))
+    assert msg in str(e.value)
+    assert str(e.value).startswith(f"{p}:")
+
+
+def test_header_version_and_format_checked(tmp_path):
+    p = tmp_path / "v2.jsonl"
+    p.write_text('{"type":"header","format":"cyl-observations","version":2}\n')
+    with pytest.raises(ObsLogError, match=r"v2.jsonl:1: unsupported version 2"):
+        read_obslog(str(p))
+    p.write_text('{"type":"header","format":"other","version":1}\n')
+    with pytest.raises(ObsLogError, match=r":1: format 'other'"):
+        read_obslog(str(p))
+    p.write_text('{"type":"frame","seq":0,"t":0}\n')
+    with pytest.raises(ObsLogError, match=r":1: first line must be the header"):
+        read_obslog(str(p))
+
+
+def test_covariances_kept_in_range_bearing_order(tmp_path):
+    p = tmp_path / "one.jsonl"
+    p.write_text('{"type":"header","format":"cyl-observations","version":1}\n'
+                 '{"type":"frame","seq":4,"t":1.5,"n_obs":1}\n'
+                 '{"type":"obs","seq":4,"t":1.5,"class":"green","range_m":2.5,"bearing_rad":-0.2,'
+                 '"cov_rr":0.04,"cov_rb":0.001,"cov_bb":0.0009,"confidence":0.7,"flags":16,'
+                 '"landmark_id":12}\n')
+    ds = read_obslog(str(p))
+    o = ds.steps[0].obs[0]
+    assert np.allclose(o.cov, [[0.04, 0.001], [0.001, 0.0009]])
+    assert (o.cls, o.range_m, o.bearing_rad, o.confidence, o.flags, o.lm_id) == \
+        ("green", 2.5, -0.2, 0.7, 16, 12)
+    assert ds.known_ids
+
+
+def test_null_fields_allowed_only_on_unusable_observations(tmp_path):
+    head = ('{"type":"header","format":"cyl-observations","version":1}\n'
+            '{"type":"frame","seq":0,"t":0}\n')
+    obs = ('{"type":"obs","seq":0,"t":0,"class":"orange","range_m":0,"bearing_rad":0.1,'
+           '"cov_rr":null,"cov_rb":null,"cov_bb":1e-4,"flags":%d}\n')
+    p = tmp_path / "n.jsonl"
+    p.write_text(head + obs % 0x100)
+    ds = read_obslog(str(p))
+    assert np.isnan(ds.steps[0].obs[0].cov[0, 0])
+    p.write_text(head + obs % 0)
+    with pytest.raises(ObsLogError, match=r"n.jsonl:3: field 'cov_rr' must be a number"):
+        read_obslog(str(p))
+
+
+def test_singular_odometry_only_an_error_when_used(tmp_path):
+    p = tmp_path / "o.jsonl"
+    odo = '{"type":"odom","seq":%d,"t":0,"dx_m":0,"dy_m":0,"dtheta_rad":0,"cov":[0,0,0,0,0,0]}\n'
+    p.write_text('{"type":"header","format":"cyl-observations","version":1}\n'
+                 '{"type":"frame","seq":0,"t":0}\n' + odo % 0 +
+                 '{"type":"frame","seq":1,"t":0.1}\n' + odo % 1)
+    with pytest.raises(ObsLogError, match=r"o.jsonl:5: odometry covariance is singular"):
+        read_obslog(str(p))
