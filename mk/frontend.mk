@@ -51,3 +51,7 @@ TEST_EXTRA_BINS += $(FE_TEST_BINS)
 # ---- make bench: end-to-end replay (issue 5) ------------------------------------------------
 $(BUILD)/bench_replay: bench/bench_replay.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
 	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) -O2 $< -o $@ $(FRONTEND_A) $(FE_SYNTH_OBJS) $(LIBCYL_A) $(CV_LIBS) -lm
+
+# ---- the cyl tool as a user meets it (exit codes, bad input, SIGINT) --------------------------
+TEST_EXTRA += $(BUILD)/cyl
+TEST_EXTRA_BINS += tests/frontend/test_cli.sh:$(BUILD)/cyl

@@ -21,7 +21,8 @@ for t in "$@"; do
     p=$(grep -aoE '[0-9]+ passed' "$out" | tail -1 | awk '{print $1+0}'); p=${p:-0}
     f=$(grep -aoE '[0-9]+ (failed|error)' "$out" | tail -1 | awk '{print $1+0}'); f=${f:-0}
   fi
-  name=$(basename "${cmd[${#cmd[@]}-1]}")
+  name=$(basename "${cmd[0]}")
+  [ ${#cmd[@]} -gt 1 ] && [[ "$t" != pytest:* ]] && name="$name $(basename "${cmd[${#cmd[@]}-1]}")"
   if [ $rc -ne 0 ] || [ "$f" -gt 0 ] || [ "$p" -eq 0 ]; then
     echo "FAIL  $name (exit $rc, $p passed, $f failed)"
     grep -aE 'FAILED|ERROR|Assert|error|failure|Failure' "$out" | head -40 | sed 's/^/      /'

@@ -5,8 +5,11 @@
  *   1. measurement point = the blob's centroid (mean of its samples, px) and its variance by
  *      the chosen estimator (cyl_noise_blob). The camera height h is the height of the optical
  *      centre above the landmark's centroid, so the ray through the blob centroid meets the
- *      plane h below the camera at the landmark's centroid height: the range is to the
- *      visible face of the landmark at that height (add diameter/2 for its axis).
+ *      plane h below the camera at the landmark's centroid height. Measured on rendered
+ *      cylinders seen from above (docs/synthetic.md, "Bias of the blob centroid"): that point
+ *      lies 0.6-1.4 cm beyond the cylinder's AXIS, not on its visible face -- the silhouette's
+ *      centroid is pulled towards the far edge of the top cap -- so the range is the axis's
+ *      (adding the radius would bias it by +5 cm).
  *   2. range, bearing, their 2x2 covariance and the (x, y) covariance (cyl_range_bearing),
  *      input covariance: diag(var_u, var_v) + the camera's intrinsic covariance + mounting
  *      sigmas.

@@ -1,0 +1,29 @@
+// Seeded random streams of the synthetic camera (internal to frontend/src/synth/): splitmix64,
+// and a standard-normal stream by Box-Muller on its outputs. Deterministic for a seed.
+#pragma once
+#include <cmath>
+#include <cstdint>
+
+namespace cylfe {
+namespace synth {
+namespace detail {
+
+inline uint64_t splitmix(uint64_t &x)
+{
+    uint64_t z = (x += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+struct NormalStream {
+    uint64_t st;
+    explicit NormalStream(uint64_t seed) : st(seed) {}
+    double uni() { return ((splitmix(st) >> 11) + 0.5) * (1.0 / 9007199254740992.0); }
+    double normal() { return std::sqrt(-2 * std::log(uni())) * std::cos(2 * 3.14159265358979323846 * uni()); }
+    double operator()() { return normal(); }
+};
+
+} // namespace detail
+} // namespace synth
+} // namespace cylfe

@@ -1,0 +1,481 @@
+// cyl: the libcyl command-line frontend. `cyl --help` lists the commands.
+#include <cerrno>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <string>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <vector>
+
+#include <opencv2/highgui.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "cylfe/calibration.hpp"
+#include "cylfe/error.hpp"
+#include "cylfe/overlay.hpp"
+#include "cylfe/pipeline.hpp"
+#include "cylfe/rawlog.hpp"
+#include "cylfe/sources.hpp"
+#include "cylfe/synth.hpp"
+#include "cylfe/v4l2.hpp"
+
+using namespace cylfe;
+
+namespace {
+
+volatile std::sig_atomic_t g_interrupted = 0;
+
+void on_signal(int)
+{
+    g_interrupted = 1;
+    V4L2Source::request_stop();
+}
+
+const char *kUsage =
+    "usage: cyl <command> [options]\n"
+    "\n"
+    "Find coloured cylinder landmarks and report range, bearing, colour, confidence and their\n"
+    "covariance for every frame.\n"
+    "\n"
+    "commands:\n"
+    "  detect SOURCE        run detection, write the observation log (JSON Lines, docs/formats.md)\n"
+    "  record SOURCE        record a source to a raw frame log (.cylraw)\n"
+    "  info FILE.cylraw     describe a raw frame log\n"
+    "  devices              list V4L2 devices              (same as --list-devices)\n"
+    "  formats [DEVICE]     list a device's pixel formats  (same as --list-formats)\n"
+    "  controls [DEVICE]    list a device's controls       (same as --list-controls)\n"
+    "\n"
+    "SOURCE is one of:\n"
+    "  /dev/videoN, v4l2:DEVICE      a V4L2 camera (YUYV, UYVY, NV12 or YU12)\n"
+    "  FILE.cylraw, raw:FILE         a recorded raw frame log\n"
+    "  IMAGE, VIDEO, file:PATH       image or video files (through OpenCV)\n"
+    "  synthetic[:SEED]              the built-in synthetic scene, with odometry and ground truth\n"
+    "\n"
+    "detect options:\n"
+    "  --table FILE         colour table (libcyl CYLT file); synthetic default calib_data/synthetic.cylt\n"
+    "  --calib FILE         camera calibration (OpenCV or ROS YAML, with libcyl's mount and sigma\n"
+    "                       fields); for the synthetic source the default is the scene's own camera\n"
+    "  --out FILE|-         observation log (default -, stdout); a file is written as FILE.part and\n"
+    "                       renamed when the run ends\n"
+    "  --model exact|paper  geometric model (default exact)\n"
+    "  --estimator local|column|uniform   centroid variance estimator (default local)\n"
+    "  --size CLASS=D,H     physical landmark size of a class in m (diameter, height), repeatable;\n"
+    "                       needed for confidence (synthetic default: the scene's)\n"
+    "  --overlay DIR|FILE.avi   write overlay images (PNG per frame) or a video\n"
+    "  --show               show the overlay in a window (needs a display; q or Esc stops)\n"
+    "  --max-frames N       stop after N frames\n"
+    "  --realtime           replay raw logs at the recorded pace (default: as fast as possible)\n"
+    "  --quiet              no progress or summary on stderr\n"
+    "record options: --out FILE.cylraw (required), --max-frames N\n"
+    "V4L2 options: --format FOURCC --size-px WxH --fps F --buffers N --timeout-ms MS --input N\n"
+    "              --fixed-exposure (turn auto exposure, white balance and gain off: colour tables\n"
+    "              need fixed exposure and white balance) --set-control NAME=VALUE (repeatable)\n"
+    "synthetic options: --frames N --seed S --scene FILE|NAME\n"
+    "\n"
+    "exit codes: 0 success, 1 failure (message names the file, line, field or device),\n"
+    "            2 bad command line, 130 interrupted (outputs closed cleanly)\n";
+
+struct Args {
+    std::string cmd, source, table, calib, out = "-", overlay, model = "exact", estimator = "local";
+    std::vector<std::string> sizes, controls;
+    uint64_t max_frames = 0;
+    bool show = false, quiet = false, fixed_exposure = false;
+    SourceOptions src;
+};
+
+[[noreturn]] void usage_error(const std::string &msg)
+{
+    std::fprintf(stderr, "cyl: %s\n(see cyl --help)\n", msg.c_str());
+    std::exit(kExitUsage);
+}
+
+uint64_t parse_u64(const std::string &opt, const std::string &v)
+{
+    char *end = nullptr;
+    errno = 0;
+    unsigned long long x = std::strtoull(v.c_str(), &end, 10);
+    if (v.empty() || *end || errno || v[0] == '-') usage_error(opt + ": expected a whole number, got '" + v + "'");
+    return x;
+}
+
+double parse_double(const std::string &opt, const std::string &v)
+{
+    char *end = nullptr;
+    double x = std::strtod(v.c_str(), &end);
+    if (v.empty() || *end || !(x == x)) usage_error(opt + ": expected a number, got '" + v + "'");
+    return x;
+}
+
+Args parse(int argc, char **argv)
+{
+    Args a;
+    std::vector<std::string> pos;
+    for (int i = 1; i < argc; i++) {
+        std::string s = argv[i];
+        auto val = [&](const std::string &name) -> std::string {
+            if (i + 1 >= argc) usage_error(name + " needs a value");
+            return argv[++i];
+        };
+        if (s == "-h" || s == "--help") { std::fputs(kUsage, stdout); std::exit(0); }
+        else if (s == "--list-devices") a.cmd = "devices";
+        else if (s == "--list-formats") a.cmd = "formats";
+        else if (s == "--list-controls") a.cmd = "controls";
+        else if (s == "--table") a.table = val(s);
+        else if (s == "--calib") a.calib = val(s);
+        else if (s == "--out" || s == "-o") a.out = val(s);
+        else if (s == "--model") a.model = val(s);
+        else if (s == "--estimator") a.estimator = val(s);
+        else if (s == "--size") a.sizes.push_back(val(s));
+        else if (s == "--overlay") a.overlay = val(s);
+        else if (s == "--show") a.show = true;
+        else if (s == "--max-frames") a.max_frames = parse_u64(s, val(s));
+        else if (s == "--realtime") a.src.realtime = true;
+        else if (s == "--quiet" || s == "-q") a.quiet = true;
+        else if (s == "--device") a.src.v4l2.device = val(s);
+        else if (s == "--format") {
+            std::string f = val(s);
+            if (f.size() != 4) usage_error("--format: a four-character code such as YUYV, got '" + f + "'");
+            a.src.v4l2.fourcc = fourcc(f[0], f[1], f[2], f[3]);
+        } else if (s == "--size-px") {
+            std::string v = val(s);
+            unsigned w = 0, h = 0;
+            char x = 0;
+            if (std::sscanf(v.c_str(), "%u%c%u", &w, &x, &h) != 3 || x != 'x' || !w || !h)
+                usage_error("--size-px: expected WIDTHxHEIGHT, got '" + v + "'");
+            a.src.v4l2.width = w;
+            a.src.v4l2.height = h;
+        } else if (s == "--fps") a.src.v4l2.fps = parse_double(s, val(s));
+        else if (s == "--buffers") a.src.v4l2.buffers = (unsigned)parse_u64(s, val(s));
+        else if (s == "--timeout-ms") a.src.v4l2.timeout_ms = (int)parse_u64(s, val(s));
+        else if (s == "--input") a.src.v4l2.input = (int)parse_u64(s, val(s));
+        else if (s == "--fixed-exposure") a.fixed_exposure = true;
+        else if (s == "--set-control") a.controls.push_back(val(s));
+        else if (s == "--frames") a.src.frames = parse_u64(s, val(s));
+        else if (s == "--seed") a.src.seed = parse_u64(s, val(s));
+        else if (s == "--scene") a.src.scene = val(s);
+        else if (s.size() > 1 && s[0] == '-') usage_error("unknown option '" + s + "'");
+        else pos.push_back(s);
+    }
+    size_t k = 0;
+    if (a.cmd.empty()) {
+        if (pos.empty()) usage_error("no command given");
+        a.cmd = pos[k++];
+    }
+    if (k < pos.size()) a.source = pos[k++];
+    if (k < pos.size()) usage_error("unexpected argument '" + pos[k] + "'");
+    return a;
+}
+
+bool is_synthetic(const std::string &s) { return s == "synthetic" || s.rfind("synthetic:", 0) == 0; }
+
+cyl_colortable load_table(const std::string &path)
+{
+    std::ifstream f(path, std::ios::binary);
+    if (!f) throw Error(path + ": cannot open colour table: " + std::strerror(errno));
+    std::vector<uint8_t> buf((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    cyl_colortable t;
+    cyl_status s = cyl_colortable_load(&t, buf.data(), buf.size());
+    if (s != CYL_OK) throw Error(path + ": " + cyl_status_str(s));
+    return t;
+}
+
+// Progress on stderr: a bar on a terminal, a line per 10% otherwise.
+class Progress {
+public:
+    explicit Progress(bool enabled) : on_(enabled), tty_(isatty(2)) {}
+    void update(double frac, uint64_t frames, double fps)
+    {
+        if (!on_ || frac < 0) return;
+        int pct = (int)std::lround(frac * 100.0);
+        if (tty_) {
+            int n = pct / 4;
+            std::fprintf(stderr, "\r[%-25s] %3d%% %llu frames %.0f fps", std::string((size_t)n, '#').c_str(), pct,
+                         (unsigned long long)frames, fps);
+        } else if (pct / 10 > last_ / 10) {
+            std::fprintf(stderr, "progress: %d%% (%llu frames, %.0f fps)\n", pct, (unsigned long long)frames, fps);
+        }
+        last_ = pct;
+    }
+    void done()
+    {
+        if (on_ && tty_) std::fputc('\n', stderr);
+    }
+
+private:
+    bool on_, tty_;
+    int last_ = -1;
+};
+
+double now_s()
+{
+    timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void apply_v4l2_options(Source &src, const Args &a, bool quiet)
+{
+    V4L2Source *v = dynamic_cast<V4L2Source *>(&src);
+    if (!v) {
+        if (a.fixed_exposure || !a.controls.empty())
+            throw Error("--fixed-exposure and --set-control apply to V4L2 sources only");
+        return;
+    }
+    if (a.fixed_exposure)
+        for (const std::string &c : v->lock_auto_controls())
+            if (!quiet) std::fprintf(stderr, "cyl: %s\n", c.c_str());
+    for (const std::string &c : a.controls) {
+        size_t eq = c.find('=');
+        if (eq == std::string::npos) usage_error("--set-control: expected NAME=VALUE, got '" + c + "'");
+        v->set_control(c.substr(0, eq), c.substr(eq + 1));
+    }
+}
+
+int cmd_detect(const Args &a)
+{
+    if (a.source.empty()) usage_error("detect: no SOURCE given");
+    cyl_geom_model model;
+    cyl_noise_estimator est;
+    if (!parse_model(a.model, &model)) usage_error("--model: exact or paper, got '" + a.model + "'");
+    if (!parse_estimator(a.estimator, &est)) usage_error("--estimator: local, column or uniform, got '" + a.estimator + "'");
+    bool synthetic = is_synthetic(a.source);
+    std::string table_path = a.table.empty() && synthetic ? "calib_data/synthetic.cylt" : a.table;
+    if (table_path.empty()) usage_error("detect: --table is required");
+    if (a.calib.empty() && !synthetic) usage_error("detect: --calib is required");
+
+    cyl_colortable table = load_table(table_path);
+    DetectorConfig cfg;
+    cfg.observe.model = model;
+    cfg.observe.estimator = est;
+    cyl_camera cam;
+    if (!a.calib.empty()) {
+        CameraCalibration cal = load_camera_calibration(a.calib);
+        if (!cal.mount_known) throw Error(a.calib + ": no mount fields (mount_tilt_deg, mount_height_m, ...): range "
+                                          "and bearing need the camera's mounting");
+        cam = cal.cam;
+    }
+    if (synthetic) {
+        synth::Scene scene = synth::scene_by_name(a.src.scene.empty() ? "default" : a.src.scene);
+        if (a.calib.empty()) cam = synth::to_cyl_camera(scene);
+        for (size_t i = 0; i < scene.classes.size() && i < CYL_MAX_CLASSES; i++)
+            cfg.observe.size[i] = {scene.landmark_diameter_m, scene.landmark_height_m};
+    }
+    for (const std::string &s : a.sizes) {
+        size_t eq = s.find('=');
+        double d = 0, h = 0;
+        char comma = 0;
+        if (eq == std::string::npos || std::sscanf(s.c_str() + eq + 1, "%lf%c%lf", &d, &comma, &h) != 3 || comma != ',' ||
+            !(d > 0) || !(h > 0))
+            usage_error("--size: expected CLASS=DIAMETER,HEIGHT in m, got '" + s + "'");
+        int cls = cyl_colortable_find_class(&table, s.substr(0, eq).c_str());
+        if (cls < 0) usage_error("--size: class '" + s.substr(0, eq) + "' is not in " + table_path);
+        cfg.observe.size[cls] = {d, h};
+    }
+
+    std::unique_ptr<Source> src = open_source(a.source, a.src);
+    apply_v4l2_options(*src, a, a.quiet);
+    Detector det(table, cam, cfg);
+    ObservationLog::Header hdr;
+    hdr.source = src->info().source.empty() ? a.source : src->info().source;
+    hdr.model = model_name(model);
+    hdr.estimator = estimator_name(est);
+    hdr.table = &table;
+    hdr.camera = &cam;
+    ObservationLog log(a.out, hdr);
+
+    bool overlay_dir = false;
+    cv::VideoWriter video;
+    if (!a.overlay.empty()) {
+        std::string o = a.overlay;
+        if (o.size() > 4 && o.compare(o.size() - 4, 4, ".avi") == 0) {
+            if (!video.open(o, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 15.0,
+                            cv::Size((int)src->info().width, (int)src->info().height)))
+                throw Error(o + ": cannot open video for writing");
+        } else {
+            if (mkdir(o.c_str(), 0777) != 0 && errno != EEXIST) throw Error(o + ": cannot create folder: " + std::strerror(errno));
+            overlay_dir = true;
+        }
+    }
+    Progress progress(!a.quiet && a.out != "-");
+    SourceEvent ev;
+    uint64_t frames = 0, observations = 0, truncated = 0;
+    double t0 = now_s();
+    while (!g_interrupted && (a.max_frames == 0 || frames < a.max_frames) && src->next(ev)) {
+        switch (ev.kind) {
+        case RecordType::Frame: {
+            const std::vector<cyl_observation> &obs = det.process(ev.image);
+            log.frame(ev.header.seq, ev.header.t_ns, obs);
+            frames++;
+            observations += obs.size();
+            truncated += det.truncated();
+            if (overlay_dir || video.isOpened() || a.show) {
+                cv::Mat bgr = to_bgr(ev.image);
+                draw_overlay(bgr, det, obs);
+                if (overlay_dir) {
+                    char name[64];
+                    std::snprintf(name, sizeof name, "/frame_%06llu.png", (unsigned long long)ev.header.seq);
+                    if (!cv::imwrite(a.overlay + name, bgr)) throw Error(a.overlay + name + ": cannot write image");
+                }
+                if (video.isOpened()) video.write(bgr);
+                if (a.show) {
+                    cv::imshow("cyl", bgr);
+                    int key = cv::waitKey(1);
+                    if (key == 'q' || key == 27) g_interrupted = 1;
+                }
+            }
+            if ((frames & 15) == 0) progress.update(src->progress(), frames, frames / (now_s() - t0 + 1e-9));
+            break;
+        }
+        case RecordType::Odometry: log.odometry(ev.header.seq, ev.header.t_ns, ev.odometry); break;
+        case RecordType::TruthPose: log.truth_pose(ev.header.seq, ev.header.t_ns, ev.truth_pose); break;
+        case RecordType::TruthLandmark: log.truth_landmark(ev.truth_landmark); break;
+        }
+    }
+    progress.update(src->progress(), frames, frames / (now_s() - t0 + 1e-9));
+    progress.done();
+    log.close();
+    if (video.isOpened()) video.release();
+    double dt = now_s() - t0;
+    if (!a.quiet)
+        std::fprintf(stderr, "cyl detect: %llu frames, %llu observations, %.1f frames/s, %llu dropped by the source%s%s\n",
+                     (unsigned long long)frames, (unsigned long long)observations, frames / (dt + 1e-9),
+                     (unsigned long long)src->dropped(),
+                     truncated ? ", some frames exceeded the run/blob capacity" : "",
+                     g_interrupted ? ", interrupted" : "");
+    if (auto *r = dynamic_cast<RawLogSource *>(src.get()))
+        if (r->truncated()) std::fprintf(stderr, "cyl detect: warning: %s ends with a truncated record (ignored)\n", a.source.c_str());
+    return g_interrupted ? kExitInterrupted : kExitOk;
+}
+
+int cmd_record(const Args &a)
+{
+    if (a.source.empty()) usage_error("record: no SOURCE given");
+    if (a.out == "-" || a.out.empty()) usage_error("record: --out FILE.cylraw is required");
+    std::unique_ptr<Source> src = open_source(a.source, a.src);
+    apply_v4l2_options(*src, a, a.quiet);
+    StreamInfo info = src->info();
+    RawLogWriter w(a.out, info);
+    Progress progress(!a.quiet);
+    SourceEvent ev;
+    uint64_t frames = 0;
+    double t0 = now_s();
+    while (!g_interrupted && (a.max_frames == 0 || frames < a.max_frames) && src->next(ev)) {
+        switch (ev.kind) {
+        case RecordType::Frame:
+            w.frame(ev.header.seq, ev.header.t_ns, ev.data, ev.header.size, ev.header.flags);
+            frames++;
+            if ((frames & 15) == 0) progress.update(src->progress(), frames, frames / (now_s() - t0 + 1e-9));
+            break;
+        case RecordType::Odometry: w.odometry(ev.header.seq, ev.header.t_ns, ev.odometry); break;
+        case RecordType::TruthPose: w.truth_pose(ev.header.seq, ev.header.t_ns, ev.truth_pose); break;
+        case RecordType::TruthLandmark: w.truth_landmark(ev.header.t_ns, ev.truth_landmark); break;
+        }
+    }
+    progress.done();
+    w.close();
+    if (!a.quiet)
+        std::fprintf(stderr, "cyl record: %llu frames (%llu records) to %s, %llu dropped by the source%s\n",
+                     (unsigned long long)frames, (unsigned long long)w.records(), a.out.c_str(),
+                     (unsigned long long)src->dropped(), g_interrupted ? ", interrupted" : "");
+    return g_interrupted ? kExitInterrupted : kExitOk;
+}
+
+int cmd_info(const Args &a)
+{
+    if (a.source.empty()) usage_error("info: no FILE given");
+    RawLogReader r(a.source);
+    const StreamInfo &i = r.info();
+    std::map<uint32_t, uint64_t> counts;
+    RecordHeader h;
+    std::vector<uint8_t> p;
+    int64_t t_first = 0, t_last = 0;
+    uint64_t frames = 0;
+    while (r.next(h, p)) {
+        counts[(uint32_t)h.type]++;
+        if (h.type == RecordType::Frame) {
+            if (!frames) t_first = h.t_ns;
+            t_last = h.t_ns;
+            frames++;
+        }
+    }
+    std::printf("file: %s\nformat: %s %ux%u, stride %u, %u bytes/frame\nsource: %s\nflags:%s%s\n", a.source.c_str(),
+                fourcc_str(i.fourcc).c_str(), i.width, i.height, i.stride, i.frame_bytes, i.source.c_str(),
+                (i.flags & StreamInfo::kMonotonic) ? " monotonic-clock" : "",
+                (i.flags & StreamInfo::kHasTruth) ? " ground-truth" : "");
+    std::printf("records: %llu frames, %llu odometry, %llu truth poses, %llu truth landmarks\n",
+                (unsigned long long)counts[1], (unsigned long long)counts[2], (unsigned long long)counts[3],
+                (unsigned long long)counts[4]);
+    if (frames > 1)
+        std::printf("duration: %.3f s, %.2f frames/s\n", (double)(t_last - t_first) * 1e-9,
+                    (double)(frames - 1) / ((double)(t_last - t_first) * 1e-9));
+    if (r.truncated()) std::printf("warning: the last record is truncated (an interrupted recording)\n");
+    return kExitOk;
+}
+
+int cmd_devices()
+{
+    std::vector<V4L2DeviceInfo> d = v4l2_list_devices();
+    if (d.empty()) std::printf("no V4L2 devices found (/dev/video*)\n");
+    for (const auto &x : d)
+        std::printf("%-14s %-10s %-28s %-24s %s\n", x.path.c_str(), x.driver.c_str(), x.card.c_str(), x.bus.c_str(),
+                    x.capture ? "capture" : "(no capture)");
+    return kExitOk;
+}
+
+int cmd_formats(const Args &a)
+{
+    std::string dev = a.source.empty() ? a.src.v4l2.device : a.source;
+    for (const auto &f : v4l2_list_formats(dev)) {
+        std::printf("%s  %-32s %s", fourcc_str(f.fourcc).c_str(), f.description.c_str(), f.supported ? "libcyl" : "      ");
+        if (f.stepwise && f.sizes.size() == 2)
+            std::printf("  %ux%u .. %ux%u", f.sizes[0].first, f.sizes[0].second, f.sizes[1].first, f.sizes[1].second);
+        else
+            for (const auto &s : f.sizes) std::printf("  %ux%u", s.first, s.second);
+        std::printf("\n");
+    }
+    return kExitOk;
+}
+
+int cmd_controls(const Args &a)
+{
+    std::string dev = a.source.empty() ? a.src.v4l2.device : a.source;
+    for (const auto &c : v4l2_list_controls(dev)) {
+        std::printf("0x%08x %-36s %lld (min %lld max %lld default %lld)%s%s\n", c.id, c.name.c_str(), (long long)c.value,
+                    (long long)c.minimum, (long long)c.maximum, (long long)c.default_value, c.read_only ? " read-only" : "",
+                    c.inactive ? " inactive" : "");
+        for (size_t i = 0; i < c.menu.size(); i++)
+            if (!c.menu[i].empty()) std::printf("             %zu: %s\n", i, c.menu[i].c_str());
+    }
+    return kExitOk;
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+    Args a = parse(argc, argv);
+    struct sigaction sa;
+    std::memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+    try {
+        if (a.cmd == "detect") return cmd_detect(a);
+        if (a.cmd == "record") return cmd_record(a);
+        if (a.cmd == "info") return cmd_info(a);
+        if (a.cmd == "devices") return cmd_devices();
+        if (a.cmd == "formats") return cmd_formats(a);
+        if (a.cmd == "controls") return cmd_controls(a);
+        usage_error("unknown command '" + a.cmd + "'");
+    } catch (const std::exception &e) {
+        std::fprintf(stderr, "cyl: error: %s\n", e.what());
+        return kExitFailure;
+    }
+}

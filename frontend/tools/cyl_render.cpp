@@ -1,0 +1,203 @@
+// cyl-render: render a synthetic drive (frames, odometry, ground truth) into a raw frame log
+// (*.cylraw, docs/formats.md); also writes scene files, the scene's colour table and camera.
+#include "cylfe/error.hpp"
+#include "cylfe/rawlog.hpp"
+#include "cylfe/synth.hpp"
+#include "cylfe/synth_experiments.hpp"
+#if __has_include("cylfe/calibration.hpp")
+#include "cylfe/calibration.hpp"
+#define CYL_RENDER_HAVE_CALIB 1
+#endif
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+using namespace cylfe;
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+void on_signal(int) { g_stop = 1; }
+
+void usage(FILE *f)
+{
+    std::fprintf(f,
+        "usage: cyl-render [options]\n"
+        "Render a synthetic drive of the robot through a scene of cylinder landmarks into a raw\n"
+        "frame log (YUYV frames, odometry with covariance, true poses and landmarks).\n"
+        "\n"
+        "  -o, --output PATH       raw log to write (default build/drive.cylraw)\n"
+        "  -n, --frames N          number of frames (default 1000)\n"
+        "  -s, --seed N            random seed: noise, odometry, exposure (default 7)\n"
+        "  -S, --scene NAME|PATH   'default' (built in), 'empty', or a scene file (YAML/JSON,\n"
+        "                          docs/synthetic.md) (default: default)\n"
+        "      --samples N         override the scene's supersampling (N x N per pixel, 1..4)\n"
+        "      --calib-error       render with a camera whose calibration differs from the scene's\n"
+        "                          by an error drawn once from the scene's sigmas (seeded); the\n"
+        "                          scene's camera (--write-camera) is then the imperfect calibration\n"
+        "      --write-scene PATH  write the scene as a scene file and exit (a template to edit)\n"
+        "      --write-table PATH  train a colour table for the scene's colours on rendered\n"
+        "                          frames (libcyl CYLT file) and exit\n"
+        "      --write-camera PATH write the scene camera as a calibration YAML and exit\n"
+        "  -q, --quiet             no progress bar\n"
+        "  -h, --help              this help\n"
+        "\n"
+        "Exit codes: 0 ok, 1 failure, 2 bad command line, 130 interrupted (the complete records\n"
+        "written so far stay in PATH.part).\n");
+}
+
+bool parse_u64(const char *s, uint64_t &v)
+{
+    char *end = nullptr;
+    errno = 0;
+    unsigned long long x = std::strtoull(s, &end, 10);
+    if (errno || !end || *end || s[0] == '-' || !*s) return false;
+    v = x;
+    return true;
+}
+
+void write_file(const std::string &path, const uint8_t *data, size_t n)
+{
+    std::string part = path + ".part";
+    FILE *f = std::fopen(part.c_str(), "wb");
+    if (!f) throw Error(path + ": cannot open for writing: " + std::strerror(errno));
+    bool ok = std::fwrite(data, 1, n, f) == n;
+    ok = (std::fclose(f) == 0) && ok;
+    if (!ok || std::rename(part.c_str(), path.c_str()) != 0) throw Error(path + ": write failed");
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+    std::string out = "build/drive.cylraw", scene_name = "default", write_scene, write_table, write_camera;
+    uint64_t frames = 1000, seed = 7, samples = 0;
+    bool quiet = false, calib_error = false;
+    for (int i = 1; i < argc; i++) {
+        std::string a = argv[i];
+        auto val = [&](const char *name) -> const char * {
+            if (i + 1 >= argc) {
+                std::fprintf(stderr, "cyl-render: %s needs a value (see --help)\n", name);
+                std::exit(kExitUsage);
+            }
+            return argv[++i];
+        };
+        if (a == "-h" || a == "--help") { usage(stdout); return kExitOk; }
+        else if (a == "-o" || a == "--output") out = val("--output");
+        else if (a == "-S" || a == "--scene") scene_name = val("--scene");
+        else if (a == "--write-scene") write_scene = val("--write-scene");
+        else if (a == "--write-table") write_table = val("--write-table");
+        else if (a == "--write-camera") write_camera = val("--write-camera");
+        else if (a == "-q" || a == "--quiet") quiet = true;
+        else if (a == "--calib-error") calib_error = true;
+        else if (a == "-n" || a == "--frames" || a == "-s" || a == "--seed" || a == "--samples") {
+            const char *v = val(a.c_str());
+            uint64_t x;
+            if (!parse_u64(v, x)) {
+                std::fprintf(stderr, "cyl-render: %s: '%s' is not a non-negative integer\n", a.c_str(), v);
+                return kExitUsage;
+            }
+            if (a == "-n" || a == "--frames") frames = x;
+            else if (a == "--samples") samples = x;
+            else seed = x;
+        } else {
+            std::fprintf(stderr, "cyl-render: unknown option '%s' (see --help)\n", a.c_str());
+            return kExitUsage;
+        }
+    }
+    if (frames == 0 || frames > 10000000) {
+        std::fprintf(stderr, "cyl-render: --frames must be 1..10000000\n");
+        return kExitUsage;
+    }
+    if (samples > 4) {
+        std::fprintf(stderr, "cyl-render: --samples must be 1..4\n");
+        return kExitUsage;
+    }
+    try {
+        synth::Scene scene = synth::scene_by_name(scene_name);
+        if (samples) scene.imaging.samples = (uint32_t)samples;
+        if (!write_scene.empty()) {
+            synth::save_scene(write_scene, scene);
+            std::fprintf(stderr, "cyl-render: wrote scene %s\n", write_scene.c_str());
+            return kExitOk;
+        }
+        if (!write_table.empty()) {
+            cyl_colortable t;
+            std::string log;
+            synth::train_colortable(scene, &t, seed, &log);
+            std::vector<uint8_t> buf(CYL_TABLE_FILE_SIZE);
+            size_t n = 0;
+            check(cyl_colortable_save(&t, buf.data(), buf.size(), &n), "cyl_colortable_save");
+            write_file(write_table, buf.data(), n);
+            if (!quiet) std::fputs(log.c_str(), stderr);
+            std::fprintf(stderr, "cyl-render: wrote colour table %s (%zu classes)\n", write_table.c_str(),
+                         scene.classes.size());
+            return kExitOk;
+        }
+        if (!write_camera.empty()) {
+#ifdef CYL_RENDER_HAVE_CALIB
+            cyl_camera cam = synth::to_cyl_camera(scene);
+            save_camera_calibration(write_camera, cam);
+            std::fprintf(stderr, "cyl-render: wrote camera %s\n", write_camera.c_str());
+            return kExitOk;
+#else
+            std::fprintf(stderr, "cyl-render: built without calibration support\n");
+            return kExitFailure;
+#endif
+        }
+        std::signal(SIGINT, on_signal);
+        std::signal(SIGTERM, on_signal);
+        if (calib_error) {
+            synth::CameraModel t = synth::perturb_camera(scene.camera, scene.sigmas, seed);
+            std::fprintf(stderr, "cyl-render: true camera = calibration + error: fx %+.3f fy %+.3f cx %+.3f cy %+.3f px, "
+                         "tilt %+.4f yaw %+.4f deg, height %+.5f offset %+.5f m\n", t.fx - scene.camera.fx,
+                         t.fy - scene.camera.fy, t.cx - scene.camera.cx, t.cy - scene.camera.cy,
+                         (t.tilt_rad - scene.camera.tilt_rad) * 57.29577951308232, (t.yaw_rad - scene.camera.yaw_rad) * 57.29577951308232,
+                         t.height_floor_m - scene.camera.height_floor_m, t.offset_m - scene.camera.offset_m);
+            scene.camera = t;
+        }
+        synth::SyntheticSource src(scene, (uint32_t)frames, seed);
+        RawLogWriter w(out, src.info());
+        SourceEvent ev;
+        auto t0 = std::chrono::steady_clock::now();
+        uint64_t nframes = 0;
+        int last_pct = -1;
+        while (!g_stop && src.next(ev)) {
+            switch (ev.kind) {
+            case RecordType::Frame: w.frame(ev.header.seq, ev.header.t_ns, ev.data, ev.header.size); nframes++; break;
+            case RecordType::Odometry: w.odometry(ev.header.seq, ev.header.t_ns, ev.odometry); break;
+            case RecordType::TruthPose: w.truth_pose(ev.header.seq, ev.header.t_ns, ev.truth_pose); break;
+            case RecordType::TruthLandmark: w.truth_landmark(ev.header.t_ns, ev.truth_landmark); break;
+            }
+            int pct = (int)(src.progress() * 100);
+            if (!quiet && pct != last_pct) {
+                last_pct = pct;
+                double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+                int bar = pct * 40 / 100;
+                std::fprintf(stderr, "\rrendering [%.*s%*s] %3d%% %llu/%llu frames %.1f s", bar,
+                             "########################################", 40 - bar, "", pct,
+                             (unsigned long long)nframes, (unsigned long long)frames, el);
+            }
+        }
+        if (g_stop) {
+            if (!quiet) std::fprintf(stderr, "\n");
+            std::fprintf(stderr, "cyl-render: interrupted after %llu frames; complete records are in %s.part\n",
+                         (unsigned long long)nframes, out.c_str());
+            return kExitInterrupted;
+        }
+        w.close();
+        double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (!quiet) std::fprintf(stderr, "\n");
+        std::fprintf(stderr, "cyl-render: wrote %s: %llu frames %ux%u YUYV, %llu records, %.1f s (%.1f ms/frame)\n",
+                     out.c_str(), (unsigned long long)nframes, src.info().width, src.info().height,
+                     (unsigned long long)w.records(), el, 1000 * el / std::max<uint64_t>(1, nframes));
+    } catch (const std::exception &e) {
+        std::fprintf(stderr, "\ncyl-render: %s\n", e.what());
+        return kExitFailure;
+    }
+    return kExitOk;
+}

@@ -1,0 +1,447 @@
+// cyl-train: colour-table training (paper section 3.3) from image files or raw-log frames, on the
+// command line or interactively in a window. Writes libcyl's CYLT table. docs/calibration.md.
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <opencv2/highgui.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "cylfe/calib.hpp"
+#include "cylfe/error.hpp"
+
+using namespace cylfe;
+using namespace cylfe::calib;
+
+namespace {
+
+const char *kUsage =
+    "usage: cyl-train -o TABLE.cylt [--base IN.cylt] [params] STEP...\n"
+    "       cyl-train --gui IMAGE|LOG.cylraw [--frame N] -o TABLE.cylt [--base IN.cylt] [--class NAME]...\n"
+    "\n"
+    "Trains libcyl colour classes (cyl_colortable_train: a UV histogram of the region, thresholded,\n"
+    "its bounding rectangle grown by a margin, and a Y window from the brightness quantiles) and\n"
+    "writes the table (CYLT format, libcyl/include/cyl/colortable.h) via a temporary file + rename.\n"
+    "Train on what the detector sees: for a V4L2 YUYV camera, record a raw log (cyl record) and\n"
+    "train on its frames (--image LOG.cylraw --frame N); image files are converted as the `cyl`\n"
+    "file source does (cv::cvtColor BGR -> YUV I420, BT.601).\n"
+    "\n"
+    "steps (processed in order):\n"
+    "  --class NAME        select class NAME (existing in --base, or the next free index)\n"
+    "  --index I           with --class: put a new class at index I (0..7; lower wins overlaps)\n"
+    "  --color R,G,B       display colour of the current class (overlays)\n"
+    "  --replace           clear the current class's colours before training it\n"
+    "  --image PATH        current image file or raw log\n"
+    "  --frame N           frame N (0-based) of the current raw log (default 0)\n"
+    "  --rect X,Y,W,H      train the current class on this rectangle of the current image\n"
+    "params (before the steps they apply to):\n"
+    "  --min-bin-count N   a UV bin needs >= N region pixels (default 2)\n"
+    "  --min-bin-fraction F  ... and >= F of the region's pixels (default 0.002)\n"
+    "  --uv-margin N       grow the UV rectangle by N bins per side (default 3)\n"
+    "  --y-margin N        widen the Y window by N levels (default 16)\n"
+    "  --y-quantiles LO,HI Y window from these quantiles (default 0.01,0.99)\n"
+    "other:\n"
+    "  -o, --out FILE      output table (required)\n"
+    "  --base FILE         start from this table (default: empty)\n"
+    "  -q, --quiet\n"
+    "\n"
+    "interactive (--gui): drag a rectangle with the left button to train the current class on it;\n"
+    "the classified pixels are shown in the classes' display colours. Keys:\n"
+    "  0-7 select class   n next class   r rename the current class (type, Enter)\n"
+    "  u undo             c clear the current class   o overlay on/off\n"
+    "  s save to -o       p write the window image to --snapshot FILE   q / Esc quit\n"
+    "  --snapshot FILE     where p writes the window image (default: TABLE.png)\n"
+    "  --scale S           display scale (default 1)\n"
+    "\n"
+    "exit codes: 0 ok, 1 failed (unreadable image or table, bad rectangle, nothing to train), 2 bad\n"
+    "command line. No partial table is ever written.\n";
+
+struct Usage : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+std::vector<double> parse_list(const std::string &opt, const std::string &v, size_t n)
+{
+    std::vector<double> out;
+    size_t pos = 0;
+    while (pos <= v.size()) {
+        size_t c = v.find(',', pos);
+        std::string part = v.substr(pos, c == std::string::npos ? std::string::npos : c - pos);
+        char *end = nullptr;
+        double d = std::strtod(part.c_str(), &end);
+        if (part.empty() || *end || !std::isfinite(d)) {
+            std::string m = opt;
+            m += ": not a number: '";
+            m += part;
+            m += "'";
+            throw Usage(m);
+        }
+        out.push_back(d);
+        if (c == std::string::npos) break;
+        pos = c + 1;
+    }
+    if (out.size() != n) throw Usage(opt + ": expected " + std::to_string(n) + " comma-separated values");
+    return out;
+}
+
+double parse_num(const std::string &opt, const std::string &v, double lo, double hi, bool integer)
+{
+    double d = parse_list(opt, v, 1)[0];
+    if (d < lo || d > hi || (integer && d != std::floor(d)))
+        throw Usage(opt + ": expected " + std::string(integer ? "an integer" : "a number") + " in [" +
+                    std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return d;
+}
+
+const uint8_t kPalette[CYL_MAX_CLASSES][3] = {{255, 120, 0}, {0, 200, 60}, {0, 90, 255}, {255, 220, 0},
+                                              {220, 0, 220}, {0, 220, 220}, {255, 255, 255}, {140, 70, 20}};
+
+// Select (or create) a class by name; index < 0: the next free slot.
+unsigned select_class(cyl_colortable &t, const std::string &name, int index)
+{
+    if (name.empty() || name.size() >= CYL_CLASS_NAME_LEN)
+        throw Usage("--class: name must be 1.." + std::to_string(CYL_CLASS_NAME_LEN - 1) + " bytes");
+    int found = cyl_colortable_find_class(&t, name.c_str());
+    if (found >= 0) {
+        if (index >= 0 && index != found)
+            throw Error("class '" + name + "' already exists at index " + std::to_string(found));
+        return (unsigned)found;
+    }
+    if (index < 0) {
+        for (int i = 0; i < CYL_MAX_CLASSES; i++)
+            if (t.name[i][0] == '\0') { index = i; break; }
+        if (index < 0) throw Error("the table already has " + std::to_string(CYL_MAX_CLASSES) + " classes");
+    } else if (t.name[index][0] != '\0')
+        throw Error("index " + std::to_string(index) + " is taken by class '" + t.name[index] + "'");
+    const uint8_t *c = kPalette[index];
+    check(cyl_colortable_set_class(&t, (unsigned)index, name.c_str(), c[0], c[1], c[2]), "--class");
+    return (unsigned)index;
+}
+
+struct Opts {
+    std::string out, base, gui, snapshot;
+    long gui_frame = 0;
+    double scale = 1.0;
+    bool quiet = false;
+    std::vector<std::string> gui_classes;
+};
+
+// ---- interactive ------------------------------------------------------------------------------
+
+constexpr int kBarHeight = 54;  // px of status bar below the image
+
+struct Gui {
+    cyl_colortable table;
+    std::vector<cyl_colortable> undo;
+    Frame frame;
+    unsigned cls = 0;
+    bool dragging = false, overlay = true, naming = false, dirty = true;
+    cv::Point p0, p1;
+    std::string status, name_buf;
+    cyl_train_params params;
+    double scale = 1.0;
+};
+
+void on_mouse(int ev, int x, int y, int, void *ud)
+{
+    Gui &g = *static_cast<Gui *>(ud);
+    cv::Point p((int)std::lround(x / g.scale), (int)std::lround(y / g.scale));
+    p.x = std::max(0, std::min((int)g.frame.img.width - 1, p.x));
+    p.y = std::max(0, std::min((int)g.frame.img.height - 1, p.y));
+    if (ev == cv::EVENT_LBUTTONDOWN) {
+        g.dragging = true;
+        g.p0 = g.p1 = p;
+        g.dirty = true;
+    } else if (ev == cv::EVENT_MOUSEMOVE && g.dragging) {
+        g.p1 = p;
+        g.dirty = true;
+    } else if (ev == cv::EVENT_LBUTTONUP && g.dragging) {
+        g.dragging = false;
+        g.p1 = p;
+        cv::Rect r(cv::Point(std::min(g.p0.x, g.p1.x), std::min(g.p0.y, g.p1.y)),
+                   cv::Point(std::max(g.p0.x, g.p1.x) + 1, std::max(g.p0.y, g.p1.y) + 1));
+        if (r.width < 3 || r.height < 3) {
+            g.status = "rectangle too small";
+        } else {
+            if (g.table.name[g.cls][0] == '\0') {
+                std::string n = "class" + std::to_string(g.cls);
+                const uint8_t *c = kPalette[g.cls];
+                cyl_colortable_set_class(&g.table, g.cls, n.c_str(), c[0], c[1], c[2]);
+            }
+            g.undo.push_back(g.table);
+            try {
+                uint8_t box[6];
+                train_rect(g.table, g.cls, g.frame, r, g.params, box);
+                char b[200];
+                std::snprintf(b, sizeof b, "trained %s on %d,%d,%d,%d: U %d-%d V %d-%d Y %d-%d, covers %.0f%%",
+                              g.table.name[g.cls], r.x, r.y, r.width, r.height, box[0], box[1], box[2], box[3], box[4],
+                              box[5], 100 * class_coverage(g.table, g.cls, g.frame, r));
+                g.status = b;
+                std::printf("%s\n", b);
+                std::fflush(stdout);
+            } catch (const Error &e) {
+                g.undo.pop_back();
+                g.status = e.what();
+            }
+        }
+        g.dirty = true;
+    }
+}
+
+cv::Mat render(const Gui &g)
+{
+    cv::Mat img = g.overlay ? classified_overlay(g.table, g.frame) : classified_overlay(cyl_colortable{}, g.frame, 0);
+    if (g.scale != 1.0) cv::resize(img, img, cv::Size(), g.scale, g.scale, cv::INTER_NEAREST);
+    if (g.dragging)
+        cv::rectangle(img, cv::Point(g.p0) * g.scale, cv::Point(g.p1) * g.scale, cv::Scalar(255, 255, 255), 1);
+    // status bar: the class, the keys, the last message
+    cv::Mat bar(kBarHeight, img.cols, CV_8UC3, cv::Scalar(40, 40, 40));
+    std::string line1 = "class " + std::to_string(g.cls) + ": " +
+                        (g.naming ? g.name_buf + "_  (type the name, Enter)" : std::string(g.table.name[g.cls]));
+    std::string line2 = "drag: train  0-7/n: class  r: rename  u: undo (" + std::to_string(g.undo.size()) +
+                        ")  c: clear  o: overlay  s: save  p: snapshot  q: quit";
+    const uint8_t *c = g.table.rgb[g.cls];
+    cv::rectangle(bar, cv::Rect(4, 4, 12, 12), cv::Scalar(c[2], c[1], c[0]), cv::FILLED);
+    cv::putText(bar, line1, cv::Point(22, 15), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(230, 230, 230), 1);
+    cv::putText(bar, line2, cv::Point(4, 32), cv::FONT_HERSHEY_SIMPLEX, 0.3, cv::Scalar(200, 200, 200), 1);
+    cv::putText(bar, g.status, cv::Point(4, 48), cv::FONT_HERSHEY_SIMPLEX, 0.35, cv::Scalar(160, 220, 255), 1);
+    cv::Mat out;
+    cv::vconcat(img, bar, out);
+    return out;
+}
+
+int run_gui(Opts &o, cyl_colortable &t, const cyl_train_params &params)
+{
+    const char *disp = std::getenv("DISPLAY");
+    if (!disp || !*disp) throw Error("--gui needs an X display (DISPLAY is not set); use the command-line steps instead");
+    Gui g;
+    g.table = t;
+    g.params = params;
+    g.scale = o.scale;
+    g.frame = load_frame(o.gui, o.gui_frame);
+    if (!o.gui_classes.empty()) g.cls = (unsigned)cyl_colortable_find_class(&g.table, o.gui_classes.front().c_str());
+    std::string snapshot = o.snapshot.empty() ? o.out + ".png" : o.snapshot;
+    const std::string win = "cyl-train";
+    cv::namedWindow(win, cv::WINDOW_AUTOSIZE | cv::WINDOW_GUI_NORMAL);  // Qt: no toolbar or status bar
+    cv::setMouseCallback(win, on_mouse, &g);
+    g.status = "drag a rectangle over a landmark";
+    std::printf("cyl-train: window open (%s)\n", g.frame.label.c_str());
+    std::fflush(stdout);
+    for (;;) {
+        if (g.dirty) {
+            cv::imshow(win, render(g));
+            g.dirty = false;
+        }
+        int k = cv::waitKey(20);
+        if (k < 0) {
+            if (cv::getWindowProperty(win, cv::WND_PROP_AUTOSIZE) < 0) break;  // window closed
+            continue;
+        }
+        k &= 0xff;
+        g.dirty = true;
+        if (g.naming) {
+            if (k == 13 || k == 10) {
+                g.naming = false;
+                if (!g.name_buf.empty()) {
+                    int other = cyl_colortable_find_class(&g.table, g.name_buf.c_str());
+                    if (other >= 0 && other != (int)g.cls)
+                        g.status = "name '" + g.name_buf + "' is taken by class " + std::to_string(other);
+                    else {
+                        g.undo.push_back(g.table);
+                        uint8_t c[3] = {g.table.rgb[g.cls][0], g.table.rgb[g.cls][1], g.table.rgb[g.cls][2]};
+                        if (g.table.name[g.cls][0] == '\0') std::memcpy(c, kPalette[g.cls], 3);
+                        cyl_colortable_set_class(&g.table, g.cls, g.name_buf.c_str(), c[0], c[1], c[2]);
+                        g.status = "class " + std::to_string(g.cls) + " named " + g.name_buf;
+                    }
+                }
+            } else if (k == 27) {
+                g.naming = false;
+            } else if (k == 8 || k == 127) {
+                if (!g.name_buf.empty()) g.name_buf.pop_back();
+            } else if (k > 32 && k < 127 && g.name_buf.size() + 1 < CYL_CLASS_NAME_LEN) {
+                g.name_buf += (char)k;
+            }
+            continue;
+        }
+        if (k == 'q' || k == 27) break;
+        if (k >= '0' && k < '0' + CYL_MAX_CLASSES) g.cls = (unsigned)(k - '0');
+        else if (k == 'n') g.cls = (g.cls + 1) % CYL_MAX_CLASSES;
+        else if (k == 'r') { g.naming = true; g.name_buf.clear(); }
+        else if (k == 'o') g.overlay = !g.overlay;
+        else if (k == 'u') {
+            if (g.undo.empty()) g.status = "nothing to undo";
+            else { g.table = g.undo.back(); g.undo.pop_back(); g.status = "undone"; }
+        } else if (k == 'c') {
+            g.undo.push_back(g.table);
+            cyl_colortable_clear_class(&g.table, g.cls);
+            g.status = "cleared class " + std::to_string(g.cls);
+        } else if (k == 's') {
+            try {
+                save_table(o.out, g.table);
+                g.status = "saved " + o.out;
+                std::printf("cyl-train: saved %s\n", o.out.c_str());
+            } catch (const Error &e) {
+                g.status = e.what();
+            }
+        } else if (k == 'p') {
+            try {
+                std::vector<uint8_t> buf;
+                cv::imencode(".png", render(g), buf);
+                write_file_atomic(snapshot, std::string(buf.begin(), buf.end()));
+                g.status = "wrote " + snapshot;
+                std::printf("cyl-train: wrote %s\n", snapshot.c_str());
+            } catch (const std::exception &e) {
+                g.status = e.what();
+            }
+        }
+        std::fflush(stdout);
+    }
+    cv::destroyAllWindows();
+    return kExitOk;
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+    Opts o;
+    std::vector<std::pair<std::string, std::string>> steps;  // (option, value) in order
+    try {
+        if (argc < 2) throw Usage("no arguments");
+        for (int i = 1; i < argc; i++) {
+            std::string s = argv[i];
+            auto next = [&]() -> std::string {
+                if (i + 1 >= argc) throw Usage(s + ": missing value");
+                return argv[++i];
+            };
+            if (s == "-h" || s == "--help") {
+                std::fputs(kUsage, stdout);
+                return kExitOk;
+            } else if (s == "-o" || s == "--out") o.out = next();
+            else if (s == "--base") o.base = next();
+            else if (s == "--gui") o.gui = next();
+            else if (s == "--snapshot") o.snapshot = next();
+            else if (s == "--scale") o.scale = parse_num(s, next(), 0.25, 4, false);
+            else if (s == "-q" || s == "--quiet") o.quiet = true;
+            else if (s == "--replace") steps.emplace_back(s, "");
+            else if (s == "--class" || s == "--index" || s == "--color" || s == "--colour" || s == "--image" ||
+                     s == "--frame" || s == "--rect" || s == "--min-bin-count" || s == "--min-bin-fraction" ||
+                     s == "--uv-margin" || s == "--y-margin" || s == "--y-quantiles")
+                steps.emplace_back(s == "--colour" ? "--color" : s, next());
+            else throw Usage("unknown argument '" + s + "'");
+        }
+        if (o.out.empty()) throw Usage("-o TABLE.cylt is required");
+        if (o.gui.empty()) {
+            bool any_rect = false;
+            for (auto &st : steps) any_rect = any_rect || st.first == "--rect";
+            if (!any_rect) throw Usage("nothing to train: give --class NAME --image FILE --rect X,Y,W,H (or --gui)");
+        }
+        // validate numbers early (bad command line -> exit 2)
+        for (auto &st : steps) {
+            if (st.first == "--index") parse_num(st.first, st.second, 0, CYL_MAX_CLASSES - 1, true);
+            else if (st.first == "--color") parse_list(st.first, st.second, 3);
+            else if (st.first == "--frame") parse_num(st.first, st.second, 0, 1e12, true);
+            else if (st.first == "--rect") parse_list(st.first, st.second, 4);
+            else if (st.first == "--min-bin-count") parse_num(st.first, st.second, 1, 1e9, true);
+            else if (st.first == "--min-bin-fraction") parse_num(st.first, st.second, 0, 1, false);
+            else if (st.first == "--uv-margin" || st.first == "--y-margin") parse_num(st.first, st.second, 0, 255, true);
+            else if (st.first == "--y-quantiles") parse_list(st.first, st.second, 2);
+            else if (st.first == "--class" && (st.second.empty() || st.second.size() >= CYL_CLASS_NAME_LEN))
+                throw Usage("--class: name must be 1.." + std::to_string(CYL_CLASS_NAME_LEN - 1) + " bytes");
+        }
+    } catch (const Usage &e) {
+        std::fprintf(stderr, "cyl-train: %s\n(cyl-train --help for usage)\n", e.what());
+        return kExitUsage;
+    }
+    try {
+        cyl_colortable t;
+        cyl_colortable_init(&t);
+        if (!o.base.empty()) load_table(o.base, t);
+        cyl_train_params params = cyl_train_params_default();
+        int cls = -1;
+        std::string pending_class;
+        std::string image;
+        long frame_index = 0;
+        Frame frame;
+        bool frame_loaded = false;
+        int trained = 0;
+        auto need_class = [&](const std::string &what) {
+            if (cls < 0) throw Error(what + " before any --class");
+        };
+        for (size_t i = 0; i < steps.size(); i++) {
+            const std::string &k = steps[i].first, &v = steps[i].second;
+            if (k == "--class") {
+                int index = -1;
+                if (i + 1 < steps.size() && steps[i + 1].first == "--index")
+                    index = (int)parse_num("--index", steps[++i].second, 0, CYL_MAX_CLASSES - 1, true);
+                cls = (int)select_class(t, v, index);
+                if (!o.gui.empty()) o.gui_classes.push_back(v);
+            } else if (k == "--index") {
+                throw Error("--index must follow --class");
+            } else if (k == "--color") {
+                need_class("--color");
+                auto c = parse_list(k, v, 3);
+                for (double x : c)
+                    if (x < 0 || x > 255) throw Error("--color: components 0..255");
+                const std::string nm = t.name[cls];  // set_class overwrites the name it is given
+                check(cyl_colortable_set_class(&t, (unsigned)cls, nm.c_str(), (uint8_t)c[0], (uint8_t)c[1], (uint8_t)c[2]),
+                      "--color");
+            } else if (k == "--replace") {
+                need_class("--replace");
+                cyl_colortable_clear_class(&t, (unsigned)cls);
+            } else if (k == "--image") {
+                image = v;
+                frame_index = 0;
+                frame_loaded = false;
+            } else if (k == "--frame") {
+                frame_index = (long)parse_num(k, v, 0, 1e12, true);
+                frame_loaded = false;
+            } else if (k == "--rect") {
+                need_class("--rect");
+                if (image.empty()) throw Error("--rect before any --image");
+                if (!frame_loaded) {
+                    frame = load_frame(image, frame_index);
+                    frame_loaded = true;
+                }
+                auto r = parse_list(k, v, 4);
+                cv::Rect rect((int)r[0], (int)r[1], (int)r[2], (int)r[3]);
+                uint8_t box[6];
+                train_rect(t, (unsigned)cls, frame, rect, params, box);
+                trained++;
+                if (!o.quiet)
+                    std::printf("%-10s %s rect %s: U %3d-%3d V %3d-%3d Y %3d-%3d, classifies %.1f%% of the rectangle\n",
+                                t.name[cls], frame.label.c_str(), v.c_str(), box[0], box[1], box[2], box[3], box[4],
+                                box[5], 100 * class_coverage(t, (unsigned)cls, frame, rect));
+            } else if (k == "--min-bin-count") params.min_bin_count = (uint32_t)parse_num(k, v, 1, 1e9, true);
+            else if (k == "--min-bin-fraction") params.min_bin_fraction = parse_num(k, v, 0, 1, false);
+            else if (k == "--uv-margin") params.uv_margin = (uint8_t)parse_num(k, v, 0, 255, true);
+            else if (k == "--y-margin") params.y_margin = (uint8_t)parse_num(k, v, 0, 255, true);
+            else if (k == "--y-quantiles") {
+                auto q = parse_list(k, v, 2);
+                if (!(q[0] >= 0 && q[0] < q[1] && q[1] <= 1)) throw Error("--y-quantiles: 0 <= LO < HI <= 1");
+                params.y_lo_fraction = q[0];
+                params.y_hi_fraction = q[1];
+            }
+        }
+        if (!o.gui.empty()) return run_gui(o, t, params);
+        save_table(o.out, t);
+        if (!o.quiet) {
+            std::printf("wrote %s (%d region(s)); classes:", o.out.c_str(), trained);
+            for (int i = 0; i < CYL_MAX_CLASSES; i++)
+                if (t.name[i][0]) std::printf(" %d=%s", i, t.name[i]);
+            std::printf("\n");
+        }
+        return kExitOk;
+    } catch (const Usage &e) {
+        std::fprintf(stderr, "cyl-train: %s\n(cyl-train --help for usage)\n", e.what());
+        return kExitUsage;
+    } catch (const std::exception &e) {
+        std::fprintf(stderr, "cyl-train: error: %s\n", e.what());
+        return kExitFailure;
+    }
+}

@@ -1,0 +1,133 @@
+#!/usr/bin/env bash
+# The cyl tool as a user meets it: exit codes, errors that name what is wrong, no partial
+# output in place of a good file, a clean stop on SIGINT that keeps every complete record.
+# Prints GoogleTest-style lines for scripts/run-tests.sh.
+#   test_cli.sh path/to/cyl
+set -u
+CYL=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
+ROOT=$(cd "$(dirname "$0")/../.." && pwd)
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+cd "$ROOT"
+TABLE=calib_data/synthetic.cylt
+CALIB=calib_data/synthetic_camera.yaml
+passed=0; failed=0; current=""; ok=1
+
+start() { current=$1; ok=1; echo "[ RUN      ] cli.$1"; }
+fail() { echo "  $*"; ok=0; }
+finish() {
+  if [ $ok -eq 1 ]; then passed=$((passed + 1)); echo "[       OK ] cli.$current"
+  else failed=$((failed + 1)); echo "[  FAILED  ] cli.$current"; fi
+}
+# expect_exit CODE PATTERN -- command...: exit code and a stderr line matching PATTERN
+expect_exit() {
+  local code=$1 pat=$2; shift 3
+  "$@" >"$T/out" 2>"$T/err"; local rc=$?
+  [ $rc -eq "$code" ] || fail "exit $rc, expected $code: $*"
+  [ -z "$pat" ] || grep -qE -- "$pat" "$T/err" || fail "stderr lacks /$pat/: $(head -c 300 "$T/err")"
+}
+valid_jsonl() {  # every line is a JSON object; prints frame and obs counts
+  python3 - "$1" <<'EOF'
+import json, sys
+frames = obs = 0
+for n, line in enumerate(open(sys.argv[1]), 1):
+    o = json.loads(line)
+    assert isinstance(o, dict) and "type" in o, f"line {n}"
+    frames += o["type"] == "frame"
+    obs += o["type"] == "obs"
+    if o["type"] == "obs" and not (o["flags"] & 0x320):
+        assert o["range_m"] > 0 and o["cov_rr"] > 0 and o["cov_bb"] > 0, f"line {n}: {o}"
+        assert o["cov_rb"] ** 2 <= o["cov_rr"] * o["cov_bb"] * (1 + 1e-9), f"line {n}: not PSD"
+print(frames, obs)
+EOF
+}
+
+start usage
+expect_exit 0 "" -- "$CYL" --help
+grep -q "usage: cyl" "$T/out" || fail "--help prints no usage"
+expect_exit 2 "no command given" -- "$CYL"
+expect_exit 2 "unknown option '--bogus'" -- "$CYL" detect x --bogus
+expect_exit 2 "--max-frames: expected a whole number" -- "$CYL" detect x --max-frames -3
+expect_exit 2 "--model: exact or paper" -- "$CYL" detect x --model wrong
+finish
+
+start record_and_info
+expect_exit 0 "" -- "$CYL" record synthetic:3 --frames 12 --out "$T/s.cylraw"
+[ -f "$T/s.cylraw" ] && [ ! -f "$T/s.cylraw.part" ] || fail "no renamed output"
+expect_exit 0 "" -- "$CYL" info "$T/s.cylraw"
+grep -q "records: 12 frames, 12 odometry, 12 truth poses" "$T/out" || fail "info: $(cat "$T/out")"
+grep -q "ground-truth" "$T/out" || fail "info: no ground-truth flag"
+finish
+
+start detect_raw_log
+expect_exit 0 "" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB --out "$T/o.jsonl" --quiet
+counts=$(valid_jsonl "$T/o.jsonl") || fail "invalid JSON lines"
+set -- $counts
+[ "${1:-0}" -eq 12 ] || fail "frames: ${1:-?}"
+[ "${2:-0}" -gt 0 ] || fail "no observations"
+grep -q '"type":"odom"' "$T/o.jsonl" || fail "no odometry passed through"
+grep -q '"type":"truth_landmark"' "$T/o.jsonl" || fail "no truth passed through"
+finish
+
+start stdout_stream
+"$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB --max-frames 3 > "$T/stdout.jsonl" 2>/dev/null || fail "exit $?"
+[ "$(grep -c '"type":"frame"' "$T/stdout.jsonl")" -eq 3 ] || fail "--max-frames 3 on stdout"
+finish
+
+start bad_inputs_name_the_problem
+expect_exit 1 "missing.cylt: cannot open colour table" -- "$CYL" detect "$T/s.cylraw" --table "$T/missing.cylt" --calib $CALIB --out "$T/x.jsonl"
+head -c 1000 $TABLE > "$T/short.cylt"
+expect_exit 1 "short.cylt: table file truncated" -- "$CYL" detect "$T/s.cylraw" --table "$T/short.cylt" --calib $CALIB --out "$T/x.jsonl"
+sed 's/^image_width:.*/image_width: wide/' $CALIB > "$T/bad.yaml"
+expect_exit 1 "bad.yaml.*image_width" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib "$T/bad.yaml" --out "$T/x.jsonl"
+grep -v '^mount_' $CALIB > "$T/nomount.yaml"
+expect_exit 1 "nomount.yaml: no mount fields" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib "$T/nomount.yaml" --out "$T/x.jsonl"
+echo "not a log" > "$T/junk.cylraw"
+expect_exit 1 "junk.cylraw: not a libcyl raw frame log" -- "$CYL" info "$T/junk.cylraw"
+expect_exit 1 "no such device" -- "$CYL" detect /dev/video77 --table $TABLE --calib $CALIB
+[ ! -e "$T/x.jsonl" ] && [ ! -e "$T/x.jsonl.part" ] || fail "a failed run left an output file"
+finish
+
+start good_output_never_replaced_by_a_failed_run
+cp "$T/o.jsonl" "$T/keep.jsonl"; sum=$(md5sum < "$T/keep.jsonl")
+expect_exit 1 "" -- "$CYL" detect "$T/junk.cylraw" --table $TABLE --calib $CALIB --out "$T/keep.jsonl"
+[ "$(md5sum < "$T/keep.jsonl")" = "$sum" ] || fail "the good file was changed"
+finish
+
+start truncated_raw_log_keeps_complete_frames
+size=$(stat -c %s "$T/s.cylraw"); head -c $((size - 1000)) "$T/s.cylraw" > "$T/cut.cylraw"
+expect_exit 0 "ends with a truncated record" -- "$CYL" detect "$T/cut.cylraw" --table $TABLE --calib $CALIB --out "$T/cut.jsonl"
+set -- $(valid_jsonl "$T/cut.jsonl")
+[ "${1:-0}" -ge 11 ] || fail "frames from a cut log: ${1:-?}"
+finish
+
+start sigint_stops_cleanly_and_keeps_records
+"$CYL" detect synthetic:5 --frames 100000 --out "$T/int.jsonl" --quiet 2>"$T/int.err" &
+pid=$!
+for i in $(seq 1 100); do
+  [ -f "$T/int.jsonl.part" ] && [ "$(grep -c '"type":"frame"' "$T/int.jsonl.part" 2>/dev/null)" -ge 3 ] && break
+  sleep 0.2
+done
+kill -INT $pid; wait $pid; rc=$?
+[ $rc -eq 130 ] || fail "exit $rc after SIGINT, expected 130"
+[ -f "$T/int.jsonl" ] && [ ! -f "$T/int.jsonl.part" ] || fail "output not closed and renamed"
+set -- $(valid_jsonl "$T/int.jsonl") || fail "invalid lines after SIGINT"
+[ "${1:-0}" -ge 3 ] || fail "frames kept: ${1:-?}"
+finish
+
+start killed_run_keeps_complete_lines_in_part_file
+"$CYL" detect synthetic:6 --frames 100000 --out "$T/kill.jsonl" --quiet 2>/dev/null &
+pid=$!
+for i in $(seq 1 100); do
+  [ -f "$T/kill.jsonl.part" ] && [ "$(grep -c '"type":"frame"' "$T/kill.jsonl.part" 2>/dev/null)" -ge 2 ] && break
+  sleep 0.2
+done
+kill -KILL $pid; wait $pid 2>/dev/null
+[ ! -f "$T/kill.jsonl" ] || fail "a killed run produced the final file"
+valid_jsonl "$T/kill.jsonl.part" >/dev/null || fail "the .part file has a broken line"
+finish
+
+echo "[==========] $((passed + failed)) tests ran."
+echo "[  PASSED  ] $passed tests."
+[ $failed -eq 0 ] || echo "[  FAILED  ] $failed tests."
+[ $failed -eq 0 ]
