@@ -84,12 +84,18 @@ test: $(STAMP)/debs-build $(STAMP)/debs-cv unit-tests cross $(TEST_EXTRA)
 	@scripts/run-tests.sh $(UNIT_BINS) $(TEST_EXTRA_BINS)
 
 # ---- demo -----------------------------------------------------------------
+# The main job (scripts/demo.sh): render a synthetic drive, detect, SLAM; last line JSON.
 $(BUILD)/segment_demo: libcyl/examples/segment_demo.c lib
 	@mkdir -p $(dir $@)
 	$(CC) -std=c99 -O2 -Wall -Wextra -Ilibcyl/include $< -o $@ $(LIBCYL_A) -lm
 
-demo: $(BUILD)/segment_demo
+demo: $(BUILD)/cyl $(BUILD)/cyl-render .venv/.stamp
+	@scripts/demo.sh
+
+# The core alone: train a table on a generated frame, segment it, print the blobs.
+demo-core: $(BUILD)/segment_demo
 	$(BUILD)/segment_demo
+.PHONY: demo-core
 
 # ---- benchmark ------------------------------------------------------------
 BENCH_C := tests/common/synth_frames.c tests/common/rng.c

@@ -293,9 +293,9 @@ int main(int argc, char **argv)
                 if (std::fabs(cr.landmark_u[i] - scene.camera.cx) < 160) { nc++; okc += cr.landmark[i] >= 0.8; }
             std::printf("  landmarks in the central half of the image width: n = %zu, >= 0.8 in %.1f%%\n", nc,
                         nc ? 100.0 * okc / nc : 0.0);
-            std::printf("  with the expected box width corrected for obliquity, lens and tilt slant (proposed fix): landmarks >= 0.8 in "
-                        "%.1f%% (quartiles %.2f %.2f %.2f), clutter <= 0.3 in %.1f%%\n", 100 * cr.landmark_fixed_ok,
-                        q(cr.landmark_fixed, 0.25), q(cr.landmark_fixed, 0.5), q(cr.landmark_fixed, 0.75), 100 * cr.clutter_fixed_ok);
+            std::printf("  with the paper's expected width fx D / depth instead: landmarks >= 0.8 in "
+                        "%.1f%% (quartiles %.2f %.2f %.2f), clutter <= 0.3 in %.1f%%\n", 100 * cr.landmark_plain_ok,
+                        q(cr.landmark_plain, 0.25), q(cr.landmark_plain, 0.5), q(cr.landmark_plain, 0.75), 100 * cr.clutter_plain_ok);
         }
         std::printf("plots: %s/{variance_estimators,range_normalised_errors,bearing_normalised_errors,"
                     "range_normalised_errors_pixel_only,bearing_normalised_errors_pixel_only}.png\n", out.c_str());
@@ -306,12 +306,12 @@ int main(int argc, char **argv)
                  "\"bearing_frac_1sigma\":%.3f,\"bearing_frac_2sigma\":%.3f,\"mean_nees\":%.3f,\"n_observations\":%zu,"
                  "\"pixel_only_range_frac_1sigma\":%.3f,\"pixel_only_bearing_frac_1sigma\":%.3f,\"pixel_only_mean_nees\":%.2f,"
                  "\"conf_landmark_frac\":%.3f,\"conf_clutter_frac\":%.3f,\"conf_landmark_ok\":%s,\"conf_clutter_ok\":%s,"
-                 "\"n_landmark_obs\":%zu,\"n_clutter_obs\":%zu,\"conf_landmark_frac_fixed_width\":%.3f,"
+                 "\"n_landmark_obs\":%zu,\"n_clutter_obs\":%zu,\"conf_landmark_frac_paper_width\":%.3f,"
                  "\"range_frac_1sigma_vs_face\":%.3f,\"range_frac_2sigma_vs_face\":%.3f,\"mean_nees_vs_face\":%.3f}",
                  lr_min, lr_max, st.range_frac1, st.range_frac2, st.bearing_frac1, st.bearing_frac2, st.mean_nees, st.n,
                  sp.range_frac1, sp.bearing_frac1, sp.mean_nees, cr.landmark_ok, cr.clutter_ok,
                  cr.landmark_ok >= 0.9 ? "true" : "false", cr.clutter_ok >= 0.9 ? "true" : "false", cr.landmark.size(),
-                 cr.clutter.size(), cr.landmark_fixed_ok, st_face.range_frac1, st_face.range_frac2, st_face.mean_nees);
+                 cr.clutter.size(), cr.landmark_plain_ok, st_face.range_frac1, st_face.range_frac2, st_face.mean_nees);
         write_text(out + "/summary.json", std::string(js) + "\n");
         std::printf("%s\n", js);
     } catch (const std::exception &e) {

@@ -81,8 +81,9 @@ cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
             o->flags |= CYL_OBS_NONLINEAR;
         {
             cyl_confidence c;
-            if (cyl_landmark_confidence(o->w_px, o->h_px, o->depth_m, cam->fx_px, cam->fy_px,
-                                        &p->size[b->cls], b->flags, &c) == CYL_OK) {
+            double we, he;
+            if (cyl_landmark_expected_size(cam, rb.xn, rb.yn, o->depth_m, &p->size[b->cls], &we, &he) == CYL_OK &&
+                cyl_landmark_confidence_expected(o->w_px, o->h_px, we, he, b->flags, &c) == CYL_OK) {
                 o->confidence = c.confidence;
                 o->confidence_uncut = c.confidence_uncut;
                 o->w_est_px = c.w_est_px;

@@ -99,11 +99,10 @@ RbStats rb_stats(const std::vector<RbSample> &s, bool against_face = false);
 struct ConfidenceResult {
     std::vector<double> landmark, clutter;  // confidences of uncut, unoccluded observations
     std::vector<double> landmark_u;         // their centroid columns, px
-    // eq. 7 with the expected bounding-box width corrected for obliquity, the lens and the slant
-    // of vertical edges under camera tilt (the fix proposed in docs/synthetic.md):
-    // w_est' = w_est (d x_d / d x) / cos(atan x_n) + h_est (fx/fy) |x_n sin t / (cos t - y_n sin t)|
-    std::vector<double> landmark_fixed, clutter_fixed;
-    double landmark_fixed_ok = 0, clutter_fixed_ok = 0;
+    // eq. 7 with the paper's expected width fx D / depth, for comparison with libcyl's
+    // expectation (cyl_landmark_expected_size: obliquity, lens and the slant under camera tilt)
+    std::vector<double> landmark_plain, clutter_plain;
+    double landmark_plain_ok = 0, clutter_plain_ok = 0;
     double landmark_ok = 0;   // fraction >= 0.8
     double clutter_ok = 0;    // fraction <= 0.3
 };

@@ -395,32 +395,26 @@ ConfidenceResult run_confidence(const Scene &s, const cyl_colortable &t, uint32_
             for (const Obj &a : objs)
                 if (a.b.valid && a.cls == (int32_t)o.cls && a.b.contains(o.u_px, o.v_px, 2)) { match = &a; nmatch++; }
             if (nmatch != 1 || match->occluded) continue;
-            // eq. 7 with the expected bounding-box width corrected (the fix proposed in
-            // docs/synthetic.md): a cylinder off the optical axis at horizontal angle a spans
-            // fx D / (depth cos a) columns on a flat sensor, times the lens's local horizontal
-            // magnification d x_d / d x; and with the camera pitched down by t the image of a
-            // vertical edge is slanted by du/dv = (fx/fy) x_n sin t / (cos t - y_n sin t), which
-            // widens the bounding box by |du/dv| h_est.
-            double fixed = 0;
+            // For comparison, eq. 7 with the paper's expected width fx D / depth (libcyl's
+            // cyl_observe now expects the wider box of an off-axis cylinder under camera tilt:
+            // cyl_landmark_expected_size, docs/synthetic.md "Landmark confidence").
+            double plain = 0;
             {
-                double xn, yn, xd, yd, J[2][2];
-                if (cyl_camera_undistort(&cam, o.u_px, o.v_px, &xn, &yn) == CYL_OK && o.w_est_px > 0) {
-                    cyl_camera_distort(&cam, xn, yn, &xd, &yd, J);
-                    double st = std::sin(cam.tilt_rad), ct = std::cos(cam.tilt_rad);
-                    double slant = std::fabs(xn * st / (ct - yn * st)) * cam.fx_px / cam.fy_px;
-                    double w_est = o.w_est_px * J[0][0] * std::sqrt(1 + xn * xn) + slant * o.h_est_px;
-                    fixed = cyl_conf_r(o.w_px / w_est) * cyl_conf_r(o.h_px / o.h_est_px);
-                }
+                cyl_landmark_size sz = {s.landmark_diameter_m, s.landmark_height_m};
+                cyl_confidence pc;
+                if (cyl_landmark_confidence(o.w_px, o.h_px, o.depth_m, cam.fx_px, cam.fy_px, &sz,
+                                            o.flags & 0x0Fu, &pc) == CYL_OK)
+                    plain = pc.confidence;
             }
             if (match->landmark) {
                 if (o.range_m >= 0.8 && o.range_m <= 4.0) {
                     res.landmark.push_back(o.confidence);
                     res.landmark_u.push_back(o.u_px);
-                    res.landmark_fixed.push_back(fixed);
+                    res.landmark_plain.push_back(plain);
                 }
             } else {
                 res.clutter.push_back(o.confidence);
-                res.clutter_fixed.push_back(fixed);
+                res.clutter_plain.push_back(plain);
             }
         }
     }
@@ -428,10 +422,10 @@ ConfidenceResult run_confidence(const Scene &s, const cyl_colortable &t, uint32_
     for (double c : res.clutter) res.clutter_ok += c <= 0.3;
     if (!res.landmark.empty()) res.landmark_ok /= res.landmark.size();
     if (!res.clutter.empty()) res.clutter_ok /= res.clutter.size();
-    for (double c : res.landmark_fixed) res.landmark_fixed_ok += c >= 0.8;
-    for (double c : res.clutter_fixed) res.clutter_fixed_ok += c <= 0.3;
-    if (!res.landmark_fixed.empty()) res.landmark_fixed_ok /= res.landmark_fixed.size();
-    if (!res.clutter_fixed.empty()) res.clutter_fixed_ok /= res.clutter_fixed.size();
+    for (double c : res.landmark_plain) res.landmark_plain_ok += c >= 0.8;
+    for (double c : res.clutter_plain) res.clutter_plain_ok += c <= 0.3;
+    if (!res.landmark_plain.empty()) res.landmark_plain_ok /= res.landmark_plain.size();
+    if (!res.clutter_plain.empty()) res.clutter_plain_ok /= res.clutter_plain.size();
     return res;
 }
 
