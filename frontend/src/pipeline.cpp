@@ -91,6 +91,20 @@ std::string str(const std::string &s)
     return o + "\"";
 }
 
+// The 8x8 prior covariance of (fx fy cx cy tilt yaw h s), row-major.
+std::string calib_cov_json(const cyl_camera &c)
+{
+    double cc[CYL_CALIB_COUNT][CYL_CALIB_COUNT];
+    cyl_calib_cov(&c, cc);
+    std::string o;
+    for (int i = 0; i < CYL_CALIB_COUNT; i++)
+        for (int j = 0; j < CYL_CALIB_COUNT; j++) {
+            if (i || j) o += ",";
+            o += num(cc[i][j]);
+        }
+    return o;
+}
+
 std::string t_sec(int64_t t_ns)
 {
     char b[40];
@@ -122,7 +136,8 @@ ObservationLog::ObservationLog(const std::string &path, const Header &h) : path_
         line += ",\"camera\":{\"width\":" + std::to_string(c.width) + ",\"height\":" + std::to_string(c.height) +
                 ",\"fx\":" + num(c.fx_px) + ",\"fy\":" + num(c.fy_px) + ",\"cx\":" + num(c.cx_px) +
                 ",\"cy\":" + num(c.cy_px) + ",\"tilt_rad\":" + num(c.tilt_rad) + ",\"yaw_rad\":" + num(c.yaw_rad) +
-                ",\"height_m\":" + num(c.height_m) + ",\"offset_m\":" + num(c.offset_m) + "}";
+                ",\"height_m\":" + num(c.height_m) + ",\"offset_m\":" + num(c.offset_m) +
+                ",\"calib_cov\":[" + calib_cov_json(c) + "]}";
     }
     write(line + "}");
 }
@@ -173,6 +188,18 @@ void ObservationLog::frame(uint64_t seq, int64_t t_ns, const std::vector<cyl_obs
         l.num("confidence", o.confidence).num("u_px", o.u_px).num("v_px", o.v_px);
         l.num("var_u_px2", o.var_u_px2).num("var_v_px2", o.var_v_px2);
         l.integer("area_px", o.area).integer("flags", o.flags);
+        std::string jm = "[", cf = "[";
+        for (int a = 0; a < 2; a++)
+            for (int k = 0; k < CYL_CALIB_COUNT; k++) {
+                if (a || k) jm += ",";
+                jm += num(o.jac_calib[a][k]);
+            }
+        cf += num(o.cov_rb_frame[0][0]);
+        cf += ",";
+        cf += num(o.cov_rb_frame[0][1]);
+        cf += ",";
+        cf += num(o.cov_rb_frame[1][1]);
+        l.raw("jac_calib", jm + "]").raw("cov_frame", cf + "]");
         write(l.done());
     }
     std::fflush(f_);

@@ -68,6 +68,8 @@ const char *kUsage =
     "  --estimator local|column|uniform   centroid variance estimator (default local)\n"
     "  --size CLASS=D,H     physical landmark size of a class in m (diameter, height), repeatable;\n"
     "                       needed for confidence (synthetic default: the scene's)\n"
+    "  --centroid-var-floor PX2   lower bound on each centroid variance, px^2 (default 0): a\n"
+    "                       model-error term for the centroid's geometric bias (docs/synthetic.md)\n"
     "  --overlay DIR|FILE.avi   write overlay images (PNG per frame) or a video\n"
     "  --show               show the overlay in a window (needs a display; q or Esc stops)\n"
     "  --max-frames N       stop after N frames\n"
@@ -85,6 +87,7 @@ const char *kUsage =
 struct Args {
     std::string cmd, source, table, calib, out = "-", overlay, model = "exact", estimator = "local";
     std::vector<std::string> sizes, controls;
+    double var_floor_px2 = 0.0;
     uint64_t max_frames = 0;
     bool show = false, quiet = false, fixed_exposure = false;
     SourceOptions src;
@@ -133,6 +136,10 @@ Args parse(int argc, char **argv)
         else if (s == "--model") a.model = val(s);
         else if (s == "--estimator") a.estimator = val(s);
         else if (s == "--size") a.sizes.push_back(val(s));
+        else if (s == "--centroid-var-floor") {
+            a.var_floor_px2 = parse_double(s, val(s));
+            if (a.var_floor_px2 < 0) usage_error("--centroid-var-floor: must be >= 0 px^2");
+        }
         else if (s == "--overlay") a.overlay = val(s);
         else if (s == "--show") a.show = true;
         else if (s == "--max-frames") a.max_frames = parse_u64(s, val(s));
@@ -254,6 +261,7 @@ int cmd_detect(const Args &a)
     DetectorConfig cfg;
     cfg.observe.model = model;
     cfg.observe.estimator = est;
+    cfg.observe.min_var_px2 = a.var_floor_px2;
     cyl_camera cam;
     if (!a.calib.empty()) {
         CameraCalibration cal = load_camera_calibration(a.calib);

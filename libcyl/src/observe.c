@@ -24,6 +24,38 @@ size_t cyl_observe_work_size(const cyl_segmentation *seg, const cyl_observe_para
     return cyl_noise_work_size_seg(seg);
 }
 
+static const int calib_in[CYL_CALIB_COUNT] = {CYL_IN_FX, CYL_IN_FY, CYL_IN_CX, CYL_IN_CY,
+                                              CYL_IN_TILT, CYL_IN_YAW, CYL_IN_H, CYL_IN_S};
+
+void cyl_calib_cov(const cyl_camera *cam, double cov[CYL_CALIB_COUNT][CYL_CALIB_COUNT])
+{
+    int i, j;
+    const double sg[4] = {cam->tilt_sigma_rad, cam->yaw_sigma_rad, cam->height_sigma_m, cam->offset_sigma_m};
+    for (i = 0; i < CYL_CALIB_COUNT; i++)
+        for (j = 0; j < CYL_CALIB_COUNT; j++)
+            cov[i][j] = (i < 4 && j < 4) ? cam->intr_cov[i][j] : (i == j ? sg[i - 4] * sg[i - 4] : 0.0);
+}
+
+/* jac_calib and cov_rb_frame: J S' J^T over the input covariance with the calibration rows and
+ * columns removed (what changes frame to frame: the centroid; and the distortion terms). */
+static void calib_share(cyl_observation *o, const cyl_camera *cam, const cyl_rb_result *rb)
+{
+    double S[CYL_IN_COUNT][CYL_IN_COUNT];
+    int a, c, k, m;
+    cyl_rb_input_cov(cam, o->var_u_px2, o->var_v_px2, 0.0, S);
+    for (k = 0; k < CYL_CALIB_COUNT; k++) {
+        for (m = 0; m < CYL_IN_COUNT; m++) S[calib_in[k]][m] = S[m][calib_in[k]] = 0.0;
+        for (a = 0; a < 2; a++) o->jac_calib[a][k] = rb->jac[a][calib_in[k]];
+    }
+    for (a = 0; a < 2; a++)
+        for (c = 0; c < 2; c++) {
+            double acc = 0.0;
+            for (k = 0; k < CYL_IN_COUNT; k++)
+                for (m = 0; m < CYL_IN_COUNT; m++) acc += rb->jac[a][k] * S[k][m] * rb->jac[c][m];
+            o->cov_rb_frame[a][c] = acc;
+        }
+}
+
 cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
                        const cyl_observe_params *p, void *work, size_t work_size,
                        cyl_observation *out, uint32_t cap, uint32_t *n_out)
@@ -77,6 +109,7 @@ cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
         o->y_m = rb.y_m;
         memcpy(o->cov_xy, rb.cov_xy, sizeof o->cov_xy);
         o->depth_m = rb.depth_m;
+        calib_share(o, cam, &rb);
         if (p->nonlinear_rel_sigma > 0.0 && sqrt(rb.cov_rb[0][0]) > p->nonlinear_rel_sigma * rb.range_m)
             o->flags |= CYL_OBS_NONLINEAR;
         {

@@ -74,6 +74,53 @@ def predict_rb(pose, lm):
     return np.array([r, b]), drb_dd @ dd
 
 
+CALIB = gtsam.symbol("c", 0)   # calibration error (fx fy cx cy tilt yaw h s): one Vector8 for the run
+
+
+def rb_jacobians(pose, lm):
+    """Predicted (bearing, range) of landmark lm from pose (x, y, theta) and their Jacobians with
+    respect to the pose (GTSAM's Pose2 retraction: body-frame (vx, vy, w)) and the landmark."""
+    dx, dy = lm[0] - pose[0], lm[1] - pose[1]
+    r2 = dx * dx + dy * dy
+    r = np.sqrt(r2)
+    c, s = np.cos(pose[2]), np.sin(pose[2])
+    b = np.arctan2(dy, dx) - pose[2]
+    hp = np.array([[(dy * c - dx * s) / r2, (-dy * s - dx * c) / r2, -1.0],
+                   [-(dx * c + dy * s) / r, -(-dx * s + dy * c) / r, 0.0]])
+    hl = np.array([[-dy / r2, dx / r2], [dx / r, dy / r]])
+    return b, r, hp, hl
+
+
+def calib_factor(pose_key, lm_key, o, noise):
+    """An observation with the calibration error as a state (docs/uncertainty.md, "Constant
+    calibration errors"): the frontend computed z with the nominal calibration, so
+    z = h(pose, lm) - J delta + n, with delta = true - nominal calibration, J = o.jac_calib and
+    n ~ N(0, o.cov_frame). Residual in GTSAM's (bearing, range) order."""
+    jbr = np.vstack([o.jac_calib[1], o.jac_calib[0]])   # (bearing, range) rows
+
+    def error(this, values, H):
+        p = values.atPose2(pose_key)
+        l = values.atPoint2(lm_key)
+        d = values.atVector(CALIB)
+        b, r, hp, hl = rb_jacobians((p.x(), p.y(), p.theta()), (l[0], l[1]))
+        e = np.array([b, r]) - jbr @ d - np.array([o.bearing_rad, o.range_m])
+        e[0] = (e[0] + np.pi) % (2 * np.pi) - np.pi
+        if H is not None:
+            H[0] = hp
+            H[1] = hl
+            H[2] = -jbr
+        return e
+
+    return gtsam.CustomFactor(noise, [pose_key, lm_key, CALIB], error)
+
+
+def calib_prior(cov):
+    """Prior N(0, cov) on the calibration error; parameters with zero variance (known exactly)
+    get a tiny one (1e-12 of the unit) so that the prior stays invertible."""
+    c = np.array(cov, float) + np.diag(np.where(np.diag(cov) > 0, 0.0, 1e-24))
+    return gtsam.PriorFactorVector(CALIB, np.zeros(8), gtsam.noiseModel.Gaussian.Covariance(c))
+
+
 def hungarian(cost):
     """Minimum-cost assignment of rows to distinct columns (rows <= cols). Returns col per row."""
     cost = np.asarray(cost, float)
@@ -143,6 +190,7 @@ class Params:
     update_every: int = 10         # iSAM2 update at least every N steps (and every observed one)
     batch: bool = True             # final batch Levenberg-Marquardt
     covariances: bool = True       # compute marginals after the batch pass
+    calib_states: bool = False     # estimate the calibration error (constant over the run) as a state
 
 
 @dataclass
@@ -195,6 +243,14 @@ class Slam:
         graph.add(f)
         new_f.add(f)
         new_v.insert(X(0), gtsam.Pose2(*start))
+        use_calib = p.calib_states and p.fixed_cov is None
+        if use_calib:
+            if getattr(ds, "calib_cov", None) is None:
+                raise ValueError("calibration states need the log header's camera.calib_cov")
+            f = calib_prior(ds.calib_cov)
+            graph.add(f)
+            new_f.add(f)
+            new_v.insert(CALIB, np.zeros(8))
         cur = start.copy()                  # current estimate of the newest pose
         lms_init = []                       # initial/latest estimate per landmark
         lm_class, lm_ids = [], []
@@ -268,8 +324,13 @@ class Slam:
                         id_to_lm[o.lm_id] = j
                     new_v.insert(L(j), gtsam.Point2(*pos))
                     st["new_landmarks"] += 1
-                f = gtsam.BearingRangeFactor2D(X(i), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
-                                               self._obs_noise(c))
+                if use_calib:
+                    if o.jac_calib is None:
+                        raise ValueError(f"{o.where}: calibration states need jac_calib and cov_frame")
+                    f = calib_factor(X(i), L(j), o, self._obs_noise(o.cov_frame))
+                else:
+                    f = gtsam.BearingRangeFactor2D(X(i), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
+                                                   self._obs_noise(c))
                 graph.add(f)
                 new_f.add(f)
                 assoc.append((i, o, j))
@@ -301,6 +362,8 @@ class Slam:
         st["n_poses"] = n
         st["n_landmarks"] = m
         st["final_error"] = graph.error(est)
+        if use_calib:
+            st["calib_error_estimate"] = [float(x) for x in est.atVector(CALIB)]
         return Result(poses=poses, pose_cov=pose_cov, isam_poses=isam_poses, lms=lms,
                       lm_cov=lm_cov, lm_class=lm_class, lm_ids=lm_ids, assoc=assoc, stats=st)
 

@@ -47,7 +47,8 @@ def _params(args, **over):
     from .backend import Params
     p = Params(assoc=args.assoc, conf_min=args.conf_min, gate_p=args.gate, new_p=args.new_gate,
                cand_radius=args.cand_radius, init_max_sigma=args.init_max_sigma, robust=args.robust, huber_k=args.huber_k,
-               anchor=args.anchor, batch=not args.no_batch, reject_flags=int(args.reject_flags, 0))
+               anchor=args.anchor, batch=not args.no_batch, reject_flags=int(args.reject_flags, 0),
+               calib_states=getattr(args, "calib_states", False))
     for k, v in over.items():
         setattr(p, k, v)
     return p
@@ -250,6 +251,11 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
                    help="gauge: first pose at the true start pose when known, else origin "
                         "(default %(default)s)")
     g.add_argument("--no-batch", action="store_true", help="skip the final batch LM pass")
+    g.add_argument("--calib-states", action="store_true",
+                   help="estimate the camera calibration's error (fx fy cx cy tilt yaw h s) as one "
+                        "state for the run: each observation's factor uses its frame covariance and "
+                        "calibration Jacobian instead of its full covariance (our logs; "
+                        "docs/uncertainty.md)")
     g.add_argument("--fixed-cov", choices=["grid", "mean", "none"], default=fixed_default,
                    help="side-by-side run with ONE fixed observation covariance: the mean of the "
                         "per-observation covariances (mean), or the best of 0.25..4 x that mean by "

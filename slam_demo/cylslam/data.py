@@ -32,6 +32,8 @@ class Obs:
     flags: int = 0
     lm_id: Optional[int] = None   # known identity (MRCLAM subject, Victoria Park id), else None
     where: str = ""               # "file:line" for messages
+    jac_calib: Optional[np.ndarray] = None   # 2x8 d(range, bearing)/d(fx fy cx cy tilt yaw h s), or None
+    cov_frame: Optional[np.ndarray] = None   # 2x2 frame-to-frame covariance (no calibration), or None
 
 
 @dataclass

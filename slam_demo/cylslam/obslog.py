@@ -76,6 +76,14 @@ def _str(rec, key, where):
     return v
 
 
+def _numlist(rec, key, n, where):
+    v = rec.get(key)
+    if (not isinstance(v, list) or len(v) != n or
+            not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)):
+        raise ObsLogError(f"{where}: field {key!r} must be a list of {n} finite numbers")
+    return [float(x) for x in v]
+
+
 def _check_cov(m, where, what):
     if not np.allclose(m, m.T):
         raise ObsLogError(f"{where}: {what} covariance is not symmetric")
@@ -158,9 +166,15 @@ class _Builder:
             cov = np.array([[crr, crb], [crb, cbb]])
             if not unusable:
                 _check_cov(cov, where, "range/bearing")
+            jm = cf = None
+            if not unusable and "jac_calib" in rec:   # optional (docs/formats.md)
+                jm = np.array(_numlist(rec, "jac_calib", 16, where)).reshape(2, 8)
+                c3 = _numlist(rec, "cov_frame", 3, where)
+                cf = np.array([[c3[0], c3[1]], [c3[1], c3[2]]])
+                _check_cov(cf, where, "cov_frame")
             fr = self._frame_of(rec, where, "obs")
             fr["obs"].append(Obs(cls=cls, range_m=r, bearing_rad=b, cov=cov, confidence=conf,
-                                 flags=flags, lm_id=lm_id, where=where))
+                                 flags=flags, lm_id=lm_id, where=where, jac_calib=jm, cov_frame=cf))
         elif typ == "odom":
             d = np.array([_num(rec, k, where) for k in ("dx_m", "dy_m", "dtheta_rad")])
             c = rec.get("cov")
@@ -281,6 +295,12 @@ def read_obslog(path, skip_bad=False) -> Dataset:
                  classes=list(classes), notes=notes, known_ids=known)
     ds.n_skipped = len(skipped)
     ds.header = header
+    cc = (header.get("camera") or {}).get("calib_cov")
+    ds.calib_cov = None
+    if isinstance(cc, list) and len(cc) == 64 and all(isinstance(x, (int, float)) and math.isfinite(x) for x in cc):
+        m = np.array(cc, float).reshape(8, 8)
+        if np.allclose(m, m.T) and np.all(np.linalg.eigvalsh(m) >= -1e-15):
+            ds.calib_cov = m
     return ds
 
 

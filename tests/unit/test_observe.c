@@ -229,6 +229,43 @@ static void test_end_to_end(void **st)
     assert_true(obs[0].confidence > 0.9);
     assert_true(fabs(obs[0].u_px - seg.blobs[0].cx_px) < 1e-9);
     assert_true(fabs(obs[0].v_px - seg.blobs[0].cy_px) < 1e-9);
+    /* The calibration's share: cov_rb_frame = the covariance with every calibration sigma zeroed
+     * (fx fy cx cy and the mount), and jac_calib against central differences. */
+    {
+        cyl_camera c0 = cam;
+        cyl_rb_result rf, rp, rm;
+        double *val[8] = {&c0.fx_px, &c0.fy_px, &c0.cx_px, &c0.cy_px, &c0.tilt_rad, &c0.yaw_rad, &c0.height_m,
+                          &c0.offset_m};
+        double step[8] = {1e-3, 1e-3, 1e-3, 1e-3, 1e-6, 1e-6, 1e-6, 1e-6}, cc[8][8];
+        int a, b, k;
+        for (a = 0; a < 4; a++)
+            for (b = 0; b < CYL_INTR_COUNT; b++) c0.intr_cov[a][b] = c0.intr_cov[b][a] = 0.0;
+        c0.tilt_sigma_rad = c0.yaw_sigma_rad = c0.height_sigma_m = c0.offset_sigma_m = 0.0;
+        assert_int_equal(cyl_range_bearing(&c0, CYL_GEOM_EXACT, obs[0].u_px, obs[0].v_px, obs[0].var_u_px2,
+                                           obs[0].var_v_px2, 0, &rf), CYL_OK);
+        for (a = 0; a < 2; a++)
+            for (b = 0; b < 2; b++)
+                assert_true(fabs(obs[0].cov_rb_frame[a][b] - rf.cov_rb[a][b]) <=
+                            1e-9 * sqrt(rf.cov_rb[a][a] * rf.cov_rb[b][b]) + 1e-18);
+        assert_true(obs[0].cov_rb_frame[0][0] < 0.1 * obs[0].cov_rb[0][0]); /* calibration dominates */
+        for (k = 0; k < 8; k++) {
+            double keep = *val[k];
+            *val[k] = keep + step[k];
+            assert_int_equal(cyl_range_bearing(&c0, CYL_GEOM_EXACT, obs[0].u_px, obs[0].v_px, 0, 0, 0, &rp), CYL_OK);
+            *val[k] = keep - step[k];
+            assert_int_equal(cyl_range_bearing(&c0, CYL_GEOM_EXACT, obs[0].u_px, obs[0].v_px, 0, 0, 0, &rm), CYL_OK);
+            *val[k] = keep;
+            for (a = 0; a < 2; a++) {
+                double fd = a == 0 ? (rp.range_m - rm.range_m) / (2 * step[k])
+                                   : (rp.bearing_rad - rm.bearing_rad) / (2 * step[k]);
+                assert_true(fabs(obs[0].jac_calib[a][k] - fd) <= 1e-6 * (fabs(fd) + 1e-6));
+            }
+        }
+        /* the prior: intrinsic block and mount variances */
+        cyl_calib_cov(&cam, cc);
+        assert_true(cc[2][2] == cam.intr_cov[CYL_INTR_CX][CYL_INTR_CX] && cc[0][1] == cam.intr_cov[0][1]);
+        assert_true(cc[4][4] == cam.tilt_sigma_rad * cam.tilt_sigma_rad && cc[4][7] == 0.0);
+    }
     free(mem);
     free(buf);
     canvas_free(&c);

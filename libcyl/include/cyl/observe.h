@@ -43,6 +43,10 @@ extern "C" {
 #define CYL_OBS_NONLINEAR   0x400u  /* sigma(range)/range > params.nonlinear_rel_sigma: the
                                        first-order covariance is no longer accurate (near the horizon) */
 
+/* Calibration parameters in cyl_observation.jac_calib: fx fy cx cy tilt yaw h s. Their prior
+ * covariance is cyl_calib_cov(). */
+#define CYL_CALIB_COUNT 8
+
 typedef struct cyl_observe_params {
     cyl_noise_estimator estimator;              /* centroid variance estimator (default CYL_NOISE_LOCAL) */
     cyl_geom_model model;                       /* geometric model (default CYL_GEOM_EXACT) */
@@ -76,6 +80,13 @@ typedef struct cyl_observation {
     double w_est_px, h_est_px;  /* expected size of a landmark of the class at depth_m, px */
     double confidence;          /* eq. 7, 0..1 (0 if cut, no range or no size) */
     double confidence_uncut;    /* score of the uncut dimensions, 0..1 (cyl_landmark_confidence) */
+    /* The calibration's share, for back ends that estimate the calibration error as a state:
+     * it is constant during a run, so per-observation factors with cov_rb are not independent
+     * (docs/uncertainty.md, "Constant calibration errors"). */
+    double jac_calib[2][CYL_CALIB_COUNT]; /* d(range_m, bearing_rad)/d(fx, fy, cx, cy [px], tilt, yaw
+                                   [rad], height, offset [m]) */
+    double cov_rb_frame[2][2];  /* cov_rb from the inputs that change frame to frame only (centroid
+                                   noise) and the distortion terms: m^2, m rad, rad^2 */
 } cyl_observation;
 
 /* The defaults above. */
@@ -90,6 +101,10 @@ size_t cyl_observe_work_size(const cyl_segmentation *seg, const cyl_observe_para
 cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
                        const cyl_observe_params *p, void *work, size_t work_size,
                        cyl_observation *out, uint32_t cap, uint32_t *n_out);
+
+/* Prior covariance of the calibration parameters of cyl_observation.jac_calib (fx fy cx cy tilt
+ * yaw h s): the camera's intrinsic covariance block and the mount variances. */
+void cyl_calib_cov(const cyl_camera *cam, double cov[CYL_CALIB_COUNT][CYL_CALIB_COUNT]);
 
 /* Error budget (Tables 8, 9) of one observation made with camera cam and model. */
 cyl_status cyl_observation_budget(const cyl_observation *obs, const cyl_camera *cam,
