@@ -106,8 +106,8 @@ $(BUILD)/bench_segment: bench/bench_segment.cpp $(BENCH_C) lib $(STAMP)/debs-cv
 	  $$(pkg-config --cflags --libs opencv4) -lm
 
 # Each part prints its table; the last line merges every part's JSON fragment.
-bench: $(BUILD)/bench_segment $(BUILD)/bench_uncertainty $(STAMP)/debs-bench
-	@extra=$$($(BUILD)/bench_uncertainty | tee /dev/stderr | tail -1) && BENCH_EXTRA_JSON="$$extra" scripts/bench.sh
+bench: $(BUILD)/bench_segment $(BUILD)/bench_uncertainty $(BUILD)/bench_replay $(BUILD)/cyl $(STAMP)/debs-bench
+	@BUILD=$(BUILD) scripts/bench.sh
 
 clean:
 	rm -rf $(BUILD) libcyl/build

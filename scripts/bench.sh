@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
-# make bench: timing medians (one run, ratios against memcpy and OpenCV) and
-# callgrind instruction counts per pixel. Prints a table and, last, one JSON line
-# merging both.
+# make bench: every benchmark in one run; each prints its table, and the last line is one JSON
+# object merging all their figures. Timing figures are medians and ratios against baselines
+# measured in the same run (memcpy, OpenCV); instruction counts come from callgrind.
+#   1. segmentation: libcyl vs memcpy vs an OpenCV pipeline, and instructions per pixel
+#   2. uncertainty: cyl_observe (noise estimation + camera model) vs cyl_segment per frame
+#   3. end-to-end replay of recorded 640x480 YUYV logs through `cyl detect` (frames/s, peak RSS
+#      of a 1,000- and a 10,000-frame log; ~6 GB of temporary disk in build/bench)
 set -euo pipefail
 B=${BUILD:-build}
-out=$("$B/bench_segment" "$@")
-echo "$out" | sed '$d'
-json=$(echo "$out" | tail -1)
+strip() { local j=$1; j=${j#\{}; echo "${j%\}}"; }
+seg=$("$B/bench_segment" "$@")
+echo "$seg" | sed '$d'
 cg=$(mktemp -d)
 K=32
 valgrind --tool=callgrind --callgrind-out-file="$cg/cg.out" --toggle-collect=cyl_segment \
@@ -15,5 +19,11 @@ ir=$(awk '/^totals:/{print $2}' "$cg/cg.out")
 ipp=$(awk -v ir="$ir" -v k=$K 'BEGIN{printf "%.2f", ir / (k * 640 * 480)}')
 echo "callgrind: cyl_segment $ir instructions over $K frames = $ipp instructions per pixel"
 rm -rf "$cg"
-extra=${BENCH_EXTRA_JSON:-}
-echo "${json%\}}, \"instr_per_pixel\": $ipp${extra}}"
+echo
+unc=$("$B/bench_uncertainty")
+echo "$unc" | sed '$d'
+echo
+rep=$("$B/bench_replay" "$B/cyl" calib_data/synthetic.cylt)
+echo "$rep" | sed '$d'
+echo
+echo "{$(strip "$(echo "$seg" | tail -1)"), \"instr_per_pixel\": $ipp$(echo "$unc" | tail -1), $(strip "$(echo "$rep" | tail -1)")}"

@@ -36,22 +36,23 @@ void cyl_calib_cov(const cyl_camera *cam, double cov[CYL_CALIB_COUNT][CYL_CALIB_
             cov[i][j] = (i < 4 && j < 4) ? cam->intr_cov[i][j] : (i == j ? sg[i - 4] * sg[i - 4] : 0.0);
 }
 
-/* jac_calib and cov_rb_frame: J S' J^T over the input covariance with the calibration rows and
- * columns removed (what changes frame to frame: the centroid; and the distortion terms). */
+/* jac_calib and cov_rb_frame: J S' J^T over the inputs that remain once the calibration's rows
+ * and columns are removed -- the centroid (u, v; var_u, var_v, independent) and the distortion
+ * terms (their block of the intrinsic covariance; usually zero, then skipped). */
 static void calib_share(cyl_observation *o, const cyl_camera *cam, const cyl_rb_result *rb)
 {
-    double S[CYL_IN_COUNT][CYL_IN_COUNT];
     int a, c, k, m;
-    cyl_rb_input_cov(cam, o->var_u_px2, o->var_v_px2, 0.0, S);
-    for (k = 0; k < CYL_CALIB_COUNT; k++) {
-        for (m = 0; m < CYL_IN_COUNT; m++) S[calib_in[k]][m] = S[m][calib_in[k]] = 0.0;
-        for (a = 0; a < 2; a++) o->jac_calib[a][k] = rb->jac[a][calib_in[k]];
-    }
+    for (a = 0; a < 2; a++)
+        for (k = 0; k < CYL_CALIB_COUNT; k++) o->jac_calib[a][k] = rb->jac[a][calib_in[k]];
     for (a = 0; a < 2; a++)
         for (c = 0; c < 2; c++) {
-            double acc = 0.0;
-            for (k = 0; k < CYL_IN_COUNT; k++)
-                for (m = 0; m < CYL_IN_COUNT; m++) acc += rb->jac[a][k] * S[k][m] * rb->jac[c][m];
+            double acc = rb->jac[a][CYL_IN_U] * o->var_u_px2 * rb->jac[c][CYL_IN_U] +
+                         rb->jac[a][CYL_IN_V] * o->var_v_px2 * rb->jac[c][CYL_IN_V];
+            for (k = CYL_INTR_K1; k <= CYL_INTR_K3; k++)
+                for (m = CYL_INTR_K1; m <= CYL_INTR_K3; m++)
+                    if (cam->intr_cov[k][m] != 0.0)
+                        acc += rb->jac[a][CYL_IN_K1 + k - CYL_INTR_K1] * cam->intr_cov[k][m] *
+                               rb->jac[c][CYL_IN_K1 + m - CYL_INTR_K1];
             o->cov_rb_frame[a][c] = acc;
         }
 }

@@ -261,6 +261,27 @@ static void test_end_to_end(void **st)
                 assert_true(fabs(obs[0].jac_calib[a][k] - fd) <= 1e-6 * (fabs(fd) + 1e-6));
             }
         }
+        /* with a distortion covariance (k1, k2 correlated) it stays in the frame covariance */
+        {
+            cyl_camera cd = cam;
+            cyl_observation od[1];
+            uint32_t nd;
+            cd.intr_cov[CYL_INTR_K1][CYL_INTR_K1] = 4e-4;
+            cd.intr_cov[CYL_INTR_K2][CYL_INTR_K2] = 1e-4;
+            cd.intr_cov[CYL_INTR_K1][CYL_INTR_K2] = cd.intr_cov[CYL_INTR_K2][CYL_INTR_K1] = -1.5e-4;
+            assert_int_equal(cyl_observe(&seg, &cd, &p, NULL, 0, od, 1, &nd), CYL_OK);
+            c0 = cd;
+            for (a = 0; a < 4; a++)
+                for (b = 0; b < CYL_INTR_COUNT; b++) c0.intr_cov[a][b] = c0.intr_cov[b][a] = 0.0;
+            c0.tilt_sigma_rad = c0.yaw_sigma_rad = c0.height_sigma_m = c0.offset_sigma_m = 0.0;
+            assert_int_equal(cyl_range_bearing(&c0, CYL_GEOM_EXACT, od[0].u_px, od[0].v_px, od[0].var_u_px2,
+                                               od[0].var_v_px2, 0, &rf), CYL_OK);
+            assert_true(rf.cov_rb[0][0] > 2.0 * obs[0].cov_rb_frame[0][0]); /* distortion matters here */
+            for (a = 0; a < 2; a++)
+                for (b = 0; b < 2; b++)
+                    assert_true(fabs(od[0].cov_rb_frame[a][b] - rf.cov_rb[a][b]) <=
+                                1e-9 * sqrt(rf.cov_rb[a][a] * rf.cov_rb[b][b]) + 1e-18);
+        }
         /* the prior: intrinsic block and mount variances */
         cyl_calib_cov(&cam, cc);
         assert_true(cc[2][2] == cam.intr_cov[CYL_INTR_CX][CYL_INTR_CX] && cc[0][1] == cam.intr_cov[0][1]);
