@@ -4,7 +4,8 @@ FRONTEND_OBJS := $(FRONTEND_SRCS:frontend/src/%.cpp=$(BUILD)/frontend/%.o)
 FRONTEND_A := $(BUILD)/frontend/libcylfe.a
 FRONTEND_HDRS := $(wildcard frontend/include/cylfe/*.hpp)
 CV_FLAGS = $(shell pkg-config --cflags opencv4 2>/dev/null)
-CV_LIBS = $(shell pkg-config --libs opencv4 2>/dev/null)
+# what the frontend links: OpenCV, and yaml-cpp for calibration files (frontend/src/calibration.cpp)
+CV_LIBS = $(shell pkg-config --libs opencv4 2>/dev/null) -lyaml-cpp
 
 $(BUILD)/frontend/%.o: frontend/src/%.cpp $(FRONTEND_HDRS) $(wildcard libcyl/include/cyl/*.h) | $(STAMP)/debs-cv
 	@mkdir -p $(dir $@)

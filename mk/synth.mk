@@ -19,7 +19,7 @@ SYNTH_OBJS := $(FE_SYNTH_OBJS)
 endif
 SYNTH_A := $(BUILD)/synth/libcylsynth.a
 SYNTH_FE_A := $(or $(FRONTEND_A),$(BUILD)/frontend/libcylfe.a)
-SYNTH_CV = $$(pkg-config --cflags --libs opencv4)
+SYNTH_CV = $$(pkg-config --cflags --libs opencv4) -lyaml-cpp
 
 $(SYNTH_A): $(SYNTH_OBJS)
 	@mkdir -p $(dir $@)

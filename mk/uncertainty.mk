@@ -4,7 +4,7 @@
 
 UNC_FE_OBJ := $(BUILD)/unc/calibration.o
 UNC_CV_CFLAGS = $$(pkg-config --cflags opencv4)
-UNC_CV_LIBS = $$(pkg-config --libs opencv4)
+UNC_CV_LIBS = $$(pkg-config --libs opencv4) -lyaml-cpp
 
 $(UNC_FE_OBJ): frontend/src/calibration.cpp frontend/include/cylfe/calibration.hpp \
 		frontend/include/cylfe/error.hpp $(wildcard libcyl/include/cyl/*.h) $(STAMP)/debs-cv

@@ -1,14 +1,20 @@
 // cylfe: camera calibration files (see calibration.hpp).
 #include "cylfe/calibration.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 #include <vector>
 
 #include <opencv2/core.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include "cylfe/error.hpp"
+
+extern "C" {
+#include "cyl/image.h"
+}
 
 namespace cylfe {
 namespace {
@@ -23,42 +29,41 @@ struct Ctx {
     }
 };
 
-// A matrix node: !!opencv-matrix, a ROS {rows, cols, data} map, or a plain sequence.
-// Returns the values row-major; checks the element count against rows*cols when given (> 0).
-std::vector<double> read_matrix(const Ctx &c, const cv::FileNode &n, const std::string &field,
-                                int rows, int cols)
+// Files are parsed with yaml-cpp, not cv::FileStorage: OpenCV 4.6's parser loops forever on
+// some malformed files (found by fuzzing, tests/fuzz/known/). Nodes are only read through const
+// references, so lookups never insert.
+using Node = YAML::Node;
+
+bool present(const Node &n) { return n.IsDefined() && !n.IsNull(); }
+
+double number(const Ctx &c, const Node &n, const std::string &field)
+{
+    if (!n.IsScalar()) c.fail(field, "expected a number");
+    double v = 0;
+    if (!YAML::convert<double>::decode(n, v)) c.fail(field, "expected a number, got '" + n.Scalar() + "'");
+    return v;
+}
+
+// A matrix node: !!opencv-matrix {rows, cols, dt, data}, a ROS {rows, cols, data} map, or a plain
+// sequence. Returns the values row-major; checks the element count against rows*cols when given
+// (> 0), and a declared size against it before reading the data.
+std::vector<double> read_matrix(const Ctx &c, const Node &n, const std::string &field, int rows, int cols)
 {
     std::vector<double> v;
-    if (n.empty() || n.isNone()) c.fail(field, "missing");
-    try {
-        if (n.isMap() && !n["dt"].empty()) {
-            // OpenCV allocates rows x cols before reading the data: check the declared size first
-            // (a fuzzed file declared 2^30 elements).
-            cv::FileNode nr = n["rows"], nc = n["cols"];
-            if (!nr.isInt() || !nc.isInt()) c.fail(field, "opencv-matrix without integer rows and cols");
-            long long dr = (int)nr, dc = (int)nc;
+    if (!present(n)) c.fail(field, "missing");
+    const Node d = n.IsMap() ? n["data"] : n;
+    if (n.IsMap()) {
+        const Node nr = n["rows"], nc = n["cols"];
+        if (present(nr) || present(nc)) {
+            double dr = number(c, nr, field + ".rows"), dc = number(c, nc, field + ".cols");
             long long want = rows > 0 ? (long long)rows * cols : 1024;
-            if (dr <= 0 || dc <= 0 || dr * dc > want)
-                c.fail(field, "declared size " + std::to_string(dr) + "x" + std::to_string(dc) + " out of range");
-            cv::Mat m;
-            n >> m;
-            if (m.empty()) c.fail(field, "empty matrix");
-            m.convertTo(m, CV_64F);
-            if (rows > 0 && (m.rows != rows || m.cols != cols) && !(m.total() == size_t(rows * cols)))
-                c.fail(field, "expected " + std::to_string(rows) + "x" + std::to_string(cols) + ", got " +
-                                  std::to_string(m.rows) + "x" + std::to_string(m.cols));
-            v.assign(m.begin<double>(), m.end<double>());
-        } else {
-            cv::FileNode d = n.isMap() ? n["data"] : n;
-            if (!d.isSeq()) c.fail(field, "expected a matrix (opencv-matrix, {rows, cols, data} or a list)");
-            for (auto it = d.begin(); it != d.end(); ++it) {
-                if (!(*it).isReal() && !(*it).isInt()) c.fail(field, "non-numeric element");
-                v.push_back((double)*it);
-            }
+            if (!(dr >= 1 && dc >= 1 && dr * dc <= (double)want) || dr != std::floor(dr) || dc != std::floor(dc))
+                c.fail(field, "declared size " + nr.Scalar() + "x" + nc.Scalar() + " out of range");
         }
-    } catch (const cv::Exception &e) {
-        c.fail(field, std::string("unreadable: ") + e.what());
     }
+    if (!d.IsSequence()) c.fail(field, "expected a matrix (opencv-matrix, {rows, cols, data} or a list)");
+    if (d.size() > 1024) c.fail(field, "too many values");
+    for (const Node &e : d) v.push_back(number(c, e, field));
     if (rows > 0 && v.size() != size_t(rows * cols))
         c.fail(field, "expected " + std::to_string(rows * cols) + " values, got " + std::to_string(v.size()));
     for (double x : v)
@@ -66,18 +71,28 @@ std::vector<double> read_matrix(const Ctx &c, const cv::FileNode &n, const std::
     return v;
 }
 
-bool read_number(const Ctx &c, const cv::FileNode &root, const std::string &field, double *out,
-                 bool required)
+bool read_number(const Ctx &c, const Node &root, const std::string &field, double *out, bool required)
 {
-    cv::FileNode n = root[field];
-    if (n.empty() || n.isNone()) {
+    const Node n = root[field];
+    if (!present(n)) {
         if (required) c.fail(field, "missing");
         return false;
     }
-    if (!n.isReal() && !n.isInt()) c.fail(field, "expected a number");
-    *out = (double)n;
+    *out = number(c, n, field);
     if (!std::isfinite(*out)) c.fail(field, "non-finite value");
     return true;
+}
+
+// yaml-cpp recurses per nesting level: refuse inputs that could nest deeply before parsing.
+void check_shape(const std::string &path, const std::string &text)
+{
+    if (text.size() > (1u << 20)) throw Error(path + ": not a calibration file: larger than 1 MiB");
+    int depth = 0, max_depth = 0;
+    for (char ch : text) {
+        if (ch == '[' || ch == '{') max_depth = std::max(max_depth, ++depth);
+        else if ((ch == ']' || ch == '}') && depth > 0) depth--;
+    }
+    if (max_depth > 16) throw Error(path + ": not a calibration file: nested more than 16 levels");
 }
 
 } // namespace
@@ -92,19 +107,20 @@ static CameraCalibration load_unchecked(const std::string &path)
     CameraCalibration cal;
     cal.path = path;
     cal.format = text.rfind("%YAML", 0) == 0 ? "opencv" : "ros";
-    // cv::FileStorage insists on the directive; ROS files are plain YAML without it
-    if (cal.format == "ros") text = "%YAML:1.0\n---\n" + text;
-    cv::FileStorage fs;
+    // OpenCV writes a non-standard "%YAML:1.0" directive: drop that line, keep the rest.
+    if (cal.format == "opencv") {
+        size_t eol = text.find('\n');
+        text = eol == std::string::npos ? std::string() : text.substr(eol + 1);
+    }
+    check_shape(path, text);
+    Node root;
     try {
-        fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-    } catch (const cv::Exception &e) {
+        root = YAML::Load(text);
+    } catch (const YAML::Exception &e) {
         throw Error(path + ": not a readable YAML calibration file: " + e.what());
     }
-    if (!fs.isOpened()) throw Error(path + ": not a readable YAML calibration file");
     Ctx c{path};
-    cv::FileNode root = fs.root();
-    // Field lookups on anything but a mapping assert inside OpenCV: reject such files here.
-    if (!root.isMap()) throw Error(path + ": not a calibration file: the top level is not a mapping of fields");
+    if (!root.IsMap()) throw Error(path + ": not a calibration file: the top level is not a mapping of fields");
     cyl_camera &cam = cal.cam;
     cyl_camera_init(&cam);
     cam.height_m = 0.0;
@@ -113,6 +129,8 @@ static CameraCalibration load_unchecked(const std::string &path)
     read_number(c, root, "image_width", &w, true);
     read_number(c, root, "image_height", &h, true);
     if (w < 1 || h < 1 || w != std::floor(w) || h != std::floor(h)) c.fail("image_width/image_height", "not positive integers");
+    if (w > CYL_MAX_DIM || h > CYL_MAX_DIM)
+        c.fail("image_width/image_height", "larger than libcyl's limit of " + std::to_string(CYL_MAX_DIM) + " px");
     cam.width = (uint32_t)w;
     cam.height = (uint32_t)h;
 
@@ -126,13 +144,13 @@ static CameraCalibration load_unchecked(const std::string &path)
     if (!(cam.fx_px > 0) || !(cam.fy_px > 0)) c.fail("camera_matrix", "focal lengths must be positive");
 
     if (cal.format == "ros") {
-        cv::FileNode m = root["distortion_model"];
-        std::string model = m.isString() ? m.string() : std::string("plumb_bob");
+        const Node m = root["distortion_model"];
+        std::string model = present(m) && m.IsScalar() ? m.Scalar() : std::string("plumb_bob");
         if (model != "plumb_bob" && model != "rational_polynomial")
             c.fail("distortion_model", "'" + model + "' is not supported (plumb_bob or rational_polynomial)");
     }
-    cv::FileNode dn = root["distortion_coefficients"];
-    if (!dn.empty() && !dn.isNone()) {
+    const Node dn = root["distortion_coefficients"];
+    if (present(dn)) {
         std::vector<double> D = read_matrix(c, dn, "distortion_coefficients", 0, 0);
         if (D.size() < 4) c.fail("distortion_coefficients", "expected at least 4 values (k1 k2 p1 p2 [k3])");
         for (size_t i = 5; i < D.size(); i++)
@@ -142,14 +160,14 @@ static CameraCalibration load_unchecked(const std::string &path)
     }
 
     // uncertainty of the intrinsics
-    cv::FileNode cn = root["intrinsic_covariance"], sn = root["intrinsic_sigmas"];
-    if (!cn.empty() && !cn.isNone()) {
+    const Node cn = root["intrinsic_covariance"], sn = root["intrinsic_sigmas"];
+    if (present(cn)) {
         std::vector<double> C = read_matrix(c, cn, "intrinsic_covariance", CYL_INTR_COUNT, CYL_INTR_COUNT);
         for (int i = 0; i < CYL_INTR_COUNT; i++)
             for (int j = 0; j < CYL_INTR_COUNT; j++) cam.intr_cov[i][j] = C[i * CYL_INTR_COUNT + j];
         cam.flags &= ~CYL_CAM_INTR_COV_UNKNOWN;
         cal.intrinsic_cov_known = true;
-    } else if (!sn.empty() && !sn.isNone()) {
+    } else if (present(sn)) {
         std::vector<double> S = read_matrix(c, sn, "intrinsic_sigmas", 0, 0);
         if (S.size() != 4 && S.size() != CYL_INTR_COUNT)
             c.fail("intrinsic_sigmas", "expected 4 (fx fy cx cy) or 9 (+ k1 k2 p1 p2 k3) values");
@@ -205,8 +223,8 @@ CameraCalibration load_camera_calibration(const std::string &path)
     } catch (const Error &) {
         throw;
     } catch (const std::exception &e) {
-        // What OpenCV's parser still throws on malformed input (cv::Exception, and std::length_error
-        // from inside cv::FileStorage on some inputs; both found by fuzzing): an error naming the file.
+        // Anything a parser or a conversion still throws on malformed input (found by fuzzing):
+        // an error naming the file.
         throw Error(path + ": unreadable calibration file: " + e.what());
     }
 }
