@@ -15,6 +15,7 @@ HOSTLIB := libcyl/build/san
 SANFLAGS := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 export ASAN_OPTIONS := detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS := print_stacktrace=1:halt_on_error=1
+export LSAN_OPTIONS := suppressions=$(CURDIR)/tests/sanitizer/lsan.supp
 else
 BUILD   := build
 HOSTLIB := libcyl/build/host

@@ -285,9 +285,12 @@ SBox screen_box(const CameraModel &cam, const CameraPose &cp, const std::vector<
         project_point(cam, cp, p.data(), &u, &v);
         u0 = std::min(u0, u); u1 = std::max(u1, u); v0 = std::min(v0, v); v1 = std::max(v1, v);
     }
+    // Points just in front of the camera plane project far outside the image (or to NaN beyond
+    // the lens model's fold): clamp before converting to int (UBSan found the overflow).
+    auto lim = [](double x) { return std::max(-1e6, std::min(1e6, x)); };
     SBox b;
-    b.x0 = (int)std::floor(u0) - 3; b.x1 = (int)std::ceil(u1) + 3;
-    b.y0 = (int)std::floor(v0) - 3; b.y1 = (int)std::ceil(v1) + 3;
+    b.x0 = (int)std::floor(lim(u0)) - 3; b.x1 = (int)std::ceil(lim(u1)) + 3;
+    b.y0 = (int)std::floor(lim(v0)) - 3; b.y1 = (int)std::ceil(lim(v1)) + 3;
     b.x0 = std::max(b.x0, 0); b.y0 = std::max(b.y0, 0);
     b.x1 = std::min(b.x1, (int)cam.width - 1); b.y1 = std::min(b.y1, (int)cam.height - 1);
     return b;
