@@ -56,3 +56,9 @@ $(BUILD)/bench_replay: bench/bench_replay.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
 # ---- the cyl tool as a user meets it (exit codes, bad input, SIGINT) --------------------------
 TEST_EXTRA += $(BUILD)/cyl
 TEST_EXTRA_BINS += tests/frontend/test_cli.sh:$(BUILD)/cyl
+
+# ---- make soak: 10,000 synthetic frames, peak memory equal to a 1,000-frame run (issue 8) ------
+soak: $(BUILD)/cyl
+	@BUILD=$(BUILD) scripts/soak.sh
+.PHONY: soak
+TEST_EXTRA_BINS += tests/frontend/test_bad_input.sh:$(BUILD)/cyl

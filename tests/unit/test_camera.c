@@ -172,9 +172,31 @@ static void test_check(void **st)
     assert_true(c.intr_cov[0][0] == 0.0);
 }
 
+/* Bad-input matrix (issue 8): NaN, infinite or negative sigmas and covariances are refused. */
+static void test_bad_sigmas_refused(void **st)
+{
+    cyl_camera c;
+    double s9[CYL_INTR_COUNT] = {0.5, 0.5, 0.3, 0.3, 0, 0, 0, 0, 0};
+    (void)st;
+    cyl_camera_init(&c);
+    c.fx_px = c.fy_px = 500; c.height_m = 0.3;
+    assert_int_equal(cyl_camera_check(&c), CYL_OK);
+    c.tilt_sigma_rad = NAN;      assert_int_equal(cyl_camera_check(&c), CYL_ERR_CAMERA); c.tilt_sigma_rad = 0;
+    c.yaw_sigma_rad = -1e-3;     assert_int_equal(cyl_camera_check(&c), CYL_ERR_CAMERA); c.yaw_sigma_rad = 0;
+    c.height_sigma_m = INFINITY; assert_int_equal(cyl_camera_check(&c), CYL_ERR_CAMERA); c.height_sigma_m = 0;
+    c.offset_sigma_m = -INFINITY; assert_int_equal(cyl_camera_check(&c), CYL_ERR_CAMERA); c.offset_sigma_m = 0;
+    s9[2] = NAN;
+    cyl_camera_set_intrinsic_sigmas(&c, s9);
+    assert_int_equal(cyl_camera_check(&c), CYL_ERR_CAMERA);
+    cyl_camera_set_intrinsic_sigmas(&c, NULL);
+    c.intr_cov[0][0] = -1.0;     assert_int_equal(cyl_camera_check(&c), CYL_ERR_CAMERA); c.intr_cov[0][0] = 0;
+    c.tilt_rad = NAN;            assert_int_equal(cyl_camera_check(&c), CYL_ERR_CAMERA);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bad_sigmas_refused),
         cmocka_unit_test(test_distort_jacobian),
         cmocka_unit_test(test_round_trip),
         cmocka_unit_test(test_undistort_jacobians),
