@@ -64,7 +64,7 @@ std::vector<double> read_matrix(const Ctx &c, const Node &n, const std::string &
     if (!d.IsSequence()) c.fail(field, "expected a matrix (opencv-matrix, {rows, cols, data} or a list)");
     if (d.size() > 1024) c.fail(field, "too many values");
     for (const Node &e : d) v.push_back(number(c, e, field));
-    if (rows > 0 && v.size() != size_t(rows * cols))
+    if (rows > 0 && v.size() != size_t(rows) * size_t(cols))
         c.fail(field, "expected " + std::to_string(rows * cols) + " values, got " + std::to_string(v.size()));
     for (double x : v)
         if (!std::isfinite(x)) c.fail(field, "non-finite value");

@@ -264,7 +264,7 @@ static int row_dense(const noise_ctx *c, const row_info ri[3], int64_t ox, wacc 
             int64_t W;
             D += d2[i];
             N += D;
-            W = (int64_t)(N * (9 - N));
+            W = (int64_t)N * (9 - N);
             w += W;
             w1 += W * x;
             w2 += W * x * x;
