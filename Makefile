@@ -100,7 +100,7 @@ demo-core: $(BUILD)/segment_demo
 
 # ---- benchmark ------------------------------------------------------------
 BENCH_C := tests/common/synth_frames.c tests/common/rng.c
-$(BUILD)/bench_segment: bench/bench_segment.cpp $(BENCH_C) lib $(STAMP)/debs-cv
+$(BUILD)/bench_segment: bench/bench_segment.cpp bench/bench_frames.hpp $(BENCH_C) lib $(STAMP)/debs-cv
 	@mkdir -p $(BUILD)/bench
 	for f in $(BENCH_C); do $(CC) $(TEST_CFLAGS) -O3 -c $$f -o $(BUILD)/bench/$$(basename $$f .c).o || exit 1; done
 	$(CXX) $(CXXFLAGS_ALL) -O3 $< $(BENCH_C:tests/common/%.c=$(BUILD)/bench/%.o) -o $@ $(LIBCYL_A) \

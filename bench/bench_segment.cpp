@@ -23,55 +23,9 @@ extern "C" {
 #include "synth_frames.h"
 }
 
-namespace {
+#include "bench_frames.hpp"
 
-constexpr uint32_t kW = 640, kH = 480;
-const uint8_t kOrange[3] = {150, 80, 190}, kGreen[3] = {140, 60, 70};
-
-// Coloured rectangles (landmarks and clutter), sensor noise and speckle.
-std::vector<uint8_t> make_frame(uint64_t seed)
-{
-    test_rng r;
-    test_rng_seed(&r, seed);
-    canvas c;
-    canvas_alloc(&c, kW, kH);
-    canvas_fill(&c, 110, 128, 128);
-    for (int i = 0; i < 6; i++) {  // walls and furniture in neutral colours
-        canvas_rect(&c, (int32_t)test_rng_int(&r, 0, kW), (int32_t)test_rng_int(&r, 0, kH),
-                    (int32_t)test_rng_int(&r, 20, 200), (int32_t)test_rng_int(&r, 20, 200),
-                    (uint8_t)test_rng_int(&r, 40, 220), (uint8_t)test_rng_int(&r, 110, 145),
-                    (uint8_t)test_rng_int(&r, 110, 145));
-    }
-    int n = (int)test_rng_int(&r, 3, 6);
-    for (int i = 0; i < n; i++) {  // cylinders seen from the side: upright rectangles
-        const uint8_t *col = (i % 2) ? kGreen : kOrange;
-        int w = (int)test_rng_int(&r, 12, 60);
-        canvas_rect(&c, (int32_t)test_rng_int(&r, 0, kW - w), (int32_t)test_rng_int(&r, 100, 300), w,
-                    (int32_t)(w * 3), col[0], col[1], col[2]);
-    }
-    canvas_noise(&c, &r, 3.0, 3.0);
-    const uint8_t speck[2][3] = {{150, 80, 190}, {140, 60, 70}};
-    canvas_speckle(&c, &r, 0.002, speck, 2);
-    std::vector<uint8_t> buf(kW * kH * 2);
-    cyl_image img;
-    canvas_to_format(&c, CYL_FMT_YUYV, 0, 0, buf.data(), buf.size(), &img);
-    canvas_free(&c);
-    return buf;
-}
-
-double median(std::vector<double> v)
-{
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
-
-double now_us()
-{
-    return std::chrono::duration<double, std::micro>(
-               std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-}  // namespace
+using namespace bench;
 
 int main(int argc, char **argv)
 {
@@ -92,11 +46,7 @@ int main(int argc, char **argv)
     for (int i = 0; i < nframes; i++) frames.push_back(make_frame(1000 + (uint64_t)i));
 
     static cyl_colortable table;
-    cyl_colortable_init(&table);
-    cyl_colortable_set_class(&table, 0, "orange", 255, 128, 0);
-    cyl_colortable_set_class(&table, 1, "green", 0, 200, 0);
-    cyl_colortable_add_box(&table, 0, 60, 240, 70, 90, 180, 200);
-    cyl_colortable_add_box(&table, 1, 60, 240, 50, 70, 60, 80);
+    make_table(&table);
     cyl_segment_params params = cyl_segment_params_default();
     const uint32_t max_runs = 40000, max_blobs = 4096;
     std::vector<uint8_t> mem(cyl_segment_mem_size(max_runs, max_blobs));

@@ -3,7 +3,7 @@
 #   build/cyl-train       colour-table training (command line and interactive window)
 #   make calib-check      our calibration vs cv::calibrateCamera on OpenCV's sample images, the
 #                         Monte Carlo of the sigmas; last line a JSON object
-# Library sources in frontend/src/calib/ -> build/calib/libcylcalib.a (not part of libcylfe.a).
+# Library sources in frontend/src/calib/ -> build/calib/libcalibtools.a (not part of libfrontend.a).
 # FRONTEND_A and the synth objects are defined in mk/frontend.mk, which is included after this
 # file: prerequisites below use the literal paths.
 DEBS_CALIB := libceres-dev libeigen3-dev libgoogle-glog-dev libgflags-dev libgtest-dev
@@ -11,8 +11,8 @@ DEBS_CALIBGUI := xvfb xdotool imagemagick
 
 CALIB_SRCS := $(sort $(wildcard frontend/src/calib/*.cpp))
 CALIB_OBJS := $(CALIB_SRCS:frontend/src/calib/%.cpp=$(BUILD)/calib/%.o)
-CALIB_A := $(BUILD)/calib/libcylcalib.a
-CALIB_FE_A := $(BUILD)/frontend/libcylfe.a
+CALIB_A := $(BUILD)/calib/libcalibtools.a
+CALIB_FE_A := $(BUILD)/frontend/libfrontend.a
 CALIB_SYNTH_OBJS := $(patsubst frontend/src/synth/%.cpp,$(BUILD)/frontend/synth/%.o,$(sort $(wildcard frontend/src/synth/*.cpp)))
 CALIB_HDRS := $(wildcard frontend/include/cylfe/*.hpp) $(wildcard libcyl/include/cyl/*.h)
 CALIB_CXXFLAGS = $(CXXFLAGS_ALL) -I/usr/include/eigen3 $(CV_FLAGS)

@@ -1,7 +1,7 @@
-# The C++ frontend: frontend/src/*.cpp -> $(BUILD)/frontend/libcylfe.a; tools in frontend/tools/.
+# The C++ frontend: frontend/src/*.cpp -> $(BUILD)/frontend/libfrontend.a; tools in frontend/tools/.
 FRONTEND_SRCS := $(sort $(wildcard frontend/src/*.cpp))
 FRONTEND_OBJS := $(FRONTEND_SRCS:frontend/src/%.cpp=$(BUILD)/frontend/%.o)
-FRONTEND_A := $(BUILD)/frontend/libcylfe.a
+FRONTEND_A := $(BUILD)/frontend/libfrontend.a
 FRONTEND_HDRS := $(wildcard frontend/include/cylfe/*.hpp)
 CV_FLAGS = $(shell pkg-config --cflags opencv4 2>/dev/null)
 # what the frontend links: OpenCV, and yaml-cpp for calibration files (frontend/src/calibration.cpp)

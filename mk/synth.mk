@@ -17,8 +17,8 @@ $(BUILD)/synth/%.o: frontend/src/synth/%.cpp $(wildcard frontend/include/cylfe/*
 else
 SYNTH_OBJS := $(FE_SYNTH_OBJS)
 endif
-SYNTH_A := $(BUILD)/synth/libcylsynth.a
-SYNTH_FE_A := $(or $(FRONTEND_A),$(BUILD)/frontend/libcylfe.a)
+SYNTH_A := $(BUILD)/synth/libsynth.a
+SYNTH_FE_A := $(or $(FRONTEND_A),$(BUILD)/frontend/libfrontend.a)
 SYNTH_CV = $$(pkg-config --cflags --libs opencv4) -lyaml-cpp
 
 $(SYNTH_A): $(SYNTH_OBJS)

@@ -30,11 +30,11 @@ TEST_EXTRA_BINS += $(BUILD)/tests/test_undistort_cv $(BUILD)/tests/test_calibrat
 
 # make bench-uncertainty: cyl_observe time per frame vs cyl_segment (issue 3: <= 10%). Its last
 # line is a JSON fragment meant for scripts/bench.sh's BENCH_EXTRA_JSON.
-$(BUILD)/bench_uncertainty: bench/bench_uncertainty.cpp tests/common/synth_frames.c tests/common/rng.c lib
+$(BUILD)/bench_uncertainty: bench/bench_uncertainty.cpp bench/bench_frames.hpp tests/common/synth_frames.c tests/common/rng.c lib
 	@mkdir -p $(dir $@)
 	$(CC) $(TEST_CFLAGS) -O3 -c tests/common/synth_frames.c -o $(BUILD)/unc_synth_frames.o
 	$(CC) $(TEST_CFLAGS) -O3 -c tests/common/rng.c -o $(BUILD)/unc_rng.o
-	$(CXX) $(CXXFLAGS_ALL) -O3 $< $(BUILD)/unc_synth_frames.o $(BUILD)/unc_rng.o -o $@ $(LIBCYL_A) -lm
+	$(CXX) $(CXXFLAGS_ALL) -Ibench -O3 $< $(BUILD)/unc_synth_frames.o $(BUILD)/unc_rng.o -o $@ $(LIBCYL_A) -lm
 
 .PHONY: bench-uncertainty
 bench-uncertainty: $(BUILD)/bench_uncertainty

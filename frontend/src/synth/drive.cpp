@@ -12,12 +12,7 @@ namespace synth {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 
-double wrap(double a)
-{
-    while (a > kPi) a -= 2 * kPi;
-    while (a <= -kPi) a += 2 * kPi;
-    return a;
-}
+using detail::wrap;
 
 void curve(const TrajectoryParams &p, double ph, double *x, double *y, double *dx, double *dy)
 {

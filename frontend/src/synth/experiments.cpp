@@ -13,12 +13,7 @@ namespace synth {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 
-double wrap(double a)
-{
-    while (a > kPi) a -= 2 * kPi;
-    while (a <= -kPi) a += 2 * kPi;
-    return a;
-}
+using detail::wrap;
 
 using detail::splitmix;
 using Rand = detail::NormalStream;

@@ -1,5 +1,6 @@
-// Seeded random streams of the synthetic camera (internal to frontend/src/synth/): splitmix64,
-// and a standard-normal stream by Box-Muller on its outputs. Deterministic for a seed.
+// Helpers internal to frontend/src/synth/: seeded random streams (splitmix64, and a
+// standard-normal stream by Box-Muller on its outputs; deterministic for a seed) and angle
+// wrapping.
 #pragma once
 #include <cmath>
 #include <cstdint>
@@ -23,6 +24,15 @@ struct NormalStream {
     double normal() { return std::sqrt(-2 * std::log(uni())) * std::cos(2 * 3.14159265358979323846 * uni()); }
     double operator()() { return normal(); }
 };
+
+// Angle wrapped to (-pi, pi].
+inline double wrap(double a)
+{
+    const double pi = 3.14159265358979323846;
+    while (a > pi) a -= 2 * pi;
+    while (a <= -pi) a += 2 * pi;
+    return a;
+}
 
 } // namespace detail
 } // namespace synth

@@ -1,0 +1,73 @@
+// The benchmarks' shared frames and timing helpers (bench_segment, bench_uncertainty):
+// distinct deterministic 640x480 YUYV frames with coloured rectangles (upright "cylinders" and
+// neutral clutter), sensor noise and speckle, and the colour table that finds their two colours.
+#pragma once
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <vector>
+
+extern "C" {
+#include "cyl/colortable.h"
+#include "synth_frames.h"
+}
+
+namespace bench {
+
+constexpr uint32_t kW = 640, kH = 480;
+inline const uint8_t kOrange[3] = {150, 80, 190}, kGreen[3] = {140, 60, 70};
+
+// Coloured rectangles (landmarks and clutter), sensor noise and speckle.
+inline std::vector<uint8_t> make_frame(uint64_t seed)
+{
+    test_rng r;
+    test_rng_seed(&r, seed);
+    canvas c;
+    canvas_alloc(&c, kW, kH);
+    canvas_fill(&c, 110, 128, 128);
+    for (int i = 0; i < 6; i++) {  // walls and furniture in neutral colours
+        canvas_rect(&c, (int32_t)test_rng_int(&r, 0, kW), (int32_t)test_rng_int(&r, 0, kH),
+                    (int32_t)test_rng_int(&r, 20, 200), (int32_t)test_rng_int(&r, 20, 200),
+                    (uint8_t)test_rng_int(&r, 40, 220), (uint8_t)test_rng_int(&r, 110, 145),
+                    (uint8_t)test_rng_int(&r, 110, 145));
+    }
+    int n = (int)test_rng_int(&r, 3, 6);
+    for (int i = 0; i < n; i++) {  // cylinders seen from the side: upright rectangles
+        const uint8_t *col = (i % 2) ? kGreen : kOrange;
+        int w = (int)test_rng_int(&r, 12, 60);
+        canvas_rect(&c, (int32_t)test_rng_int(&r, 0, kW - w), (int32_t)test_rng_int(&r, 100, 300), w,
+                    (int32_t)(w * 3), col[0], col[1], col[2]);
+    }
+    canvas_noise(&c, &r, 3.0, 3.0);
+    const uint8_t speck[2][3] = {{150, 80, 190}, {140, 60, 70}};
+    canvas_speckle(&c, &r, 0.002, speck, 2);
+    std::vector<uint8_t> buf(kW * kH * 2);
+    cyl_image img;
+    canvas_to_format(&c, CYL_FMT_YUYV, 0, 0, buf.data(), buf.size(), &img);
+    canvas_free(&c);
+    return buf;
+}
+
+inline double median(std::vector<double> v)
+{
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+inline double now_us()
+{
+    return std::chrono::duration<double, std::micro>(
+               std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// The table both benchmarks use: orange and green as CMVision-style boxes.
+inline void make_table(cyl_colortable *table)
+{
+    cyl_colortable_init(table);
+    cyl_colortable_set_class(table, 0, "orange", 255, 128, 0);
+    cyl_colortable_set_class(table, 1, "green", 0, 200, 0);
+    cyl_colortable_add_box(table, 0, 60, 240, 70, 90, 180, 200);
+    cyl_colortable_add_box(table, 1, 60, 240, 50, 70, 60, 80);
+}
+
+} // namespace bench
