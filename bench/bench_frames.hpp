@@ -9,6 +9,7 @@
 
 extern "C" {
 #include "cyl/colortable.h"
+#include "cyl/segment.h"
 #include "synth_frames.h"
 }
 
@@ -69,5 +70,21 @@ inline void make_table(cyl_colortable *table)
     cyl_colortable_add_box(table, 0, 60, 240, 70, 90, 180, 200);
     cyl_colortable_add_box(table, 1, 60, 240, 50, 70, 60, 80);
 }
+
+// The benchmarks' shared set-up: nframes distinct frames, the table, and segmentation memory.
+struct Setup {
+    std::vector<std::vector<uint8_t>> frames;
+    cyl_colortable table;
+    cyl_segment_params params = cyl_segment_params_default();
+    std::vector<uint8_t> mem;
+    cyl_segmentation seg{};
+    explicit Setup(int nframes, uint32_t max_runs = 40000, uint32_t max_blobs = 4096)
+    {
+        for (int i = 0; i < nframes; i++) frames.push_back(make_frame(1000 + (uint64_t)i));
+        make_table(&table);
+        mem.resize(cyl_segment_mem_size(max_runs, max_blobs));
+        cyl_segmentation_init(&seg, mem.data(), mem.size(), max_runs, max_blobs);
+    }
+};
 
 } // namespace bench

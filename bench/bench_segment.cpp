@@ -42,16 +42,11 @@ int main(int argc, char **argv)
     }
     if (iterations < 1 || nframes < 1) { std::fprintf(stderr, "bench_segment: counts must be >= 1\n"); return 2; }
 
-    std::vector<std::vector<uint8_t>> frames;
-    for (int i = 0; i < nframes; i++) frames.push_back(make_frame(1000 + (uint64_t)i));
-
-    static cyl_colortable table;
-    make_table(&table);
-    cyl_segment_params params = cyl_segment_params_default();
-    const uint32_t max_runs = 40000, max_blobs = 4096;
-    std::vector<uint8_t> mem(cyl_segment_mem_size(max_runs, max_blobs));
-    cyl_segmentation seg;
-    cyl_segmentation_init(&seg, mem.data(), mem.size(), max_runs, max_blobs);
+    static Setup set(nframes);  // static: the table is 66 KB
+    const std::vector<std::vector<uint8_t>> &frames = set.frames;
+    const cyl_colortable &table = set.table;
+    const cyl_segment_params &params = set.params;
+    cyl_segmentation &seg = set.seg;
 
     if (callgrind > 0) {
         unsigned long blobs = 0;

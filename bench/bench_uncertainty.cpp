@@ -24,15 +24,11 @@ int main(int argc, char **argv)
 {
     int iterations = argc > 1 ? std::atoi(argv[1]) : 400;
     const int nframes = 8;
-    std::vector<std::vector<uint8_t>> frames;
-    for (int i = 0; i < nframes; i++) frames.push_back(make_frame(1000 + (uint64_t)i));
-    static cyl_colortable table;
-    make_table(&table);
-    cyl_segment_params params = cyl_segment_params_default();
-    const uint32_t max_runs = 40000, max_blobs = 4096;
-    std::vector<uint8_t> mem(cyl_segment_mem_size(max_runs, max_blobs));
-    cyl_segmentation seg;
-    cyl_segmentation_init(&seg, mem.data(), mem.size(), max_runs, max_blobs);
+    static Setup set(nframes);  // static: the table is 66 KB
+    const std::vector<std::vector<uint8_t>> &frames = set.frames;
+    const cyl_colortable &table = set.table;
+    const cyl_segment_params &params = set.params;
+    cyl_segmentation &seg = set.seg;
 
     // the paper's camera (Tables 4, 5; docs/uncertainty.md), centred for 640x480
     cyl_camera cam;
@@ -49,7 +45,7 @@ int main(int argc, char **argv)
     cyl_observe_params op = cyl_observe_params_default();
     op.size[0].diameter_m = op.size[1].diameter_m = 0.10;
     op.size[0].height_m = op.size[1].height_m = 0.30;
-    std::vector<cyl_observation> obs(max_blobs);
+    std::vector<cyl_observation> obs(seg.max_blobs);
 
     std::vector<double> t_seg, t_obs;
     unsigned long nobs = 0, nblobs = 0;

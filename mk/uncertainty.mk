@@ -2,14 +2,11 @@
 #   make paper       the paper's Tables 6, 8, 9 beside ours; last line JSON
 # Test programs added to `make test`: build/tests/test_undistort_cv, build/tests/test_calibration.
 
-UNC_FE_OBJ := $(BUILD)/unc/calibration.o
+# The calibration reader comes from the frontend library (mk/frontend.mk, included after this file:
+# hence the literal path).
+UNC_FE_OBJ := $(BUILD)/frontend/libfrontend.a
 UNC_CV_CFLAGS = $$(pkg-config --cflags opencv4)
 UNC_CV_LIBS = $$(pkg-config --libs opencv4) -lyaml-cpp
-
-$(UNC_FE_OBJ): frontend/src/calibration.cpp frontend/include/cylfe/calibration.hpp \
-		frontend/include/cylfe/error.hpp $(wildcard libcyl/include/cyl/*.h) $(STAMP)/debs-cv
-	@mkdir -p $(dir $@)
-	$(CXX) $(CXXFLAGS_ALL) $(UNC_CV_CFLAGS) -c $< -o $@
 
 $(BUILD)/cyl_paper: frontend/tools/cyl_paper.cpp $(UNC_FE_OBJ) lib
 	@mkdir -p $(dir $@)

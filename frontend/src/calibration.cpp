@@ -2,10 +2,14 @@
 #include "cylfe/calibration.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 #include <vector>
+#include <unistd.h>
 
 #include <opencv2/core.hpp>
 #include <yaml-cpp/yaml.h>
@@ -229,22 +233,48 @@ CameraCalibration load_camera_calibration(const std::string &path)
     }
 }
 
-void save_camera_calibration(const std::string &path, const cyl_camera &cam)
+void write_file_atomic(const std::string &path, const std::string &text)
 {
-    cv::FileStorage fs(path, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
-    if (!fs.isOpened()) throw Error(path + ": cannot write camera calibration file");
+    std::string tmp = path + ".tmp." + std::to_string(getpid());
+    FILE *f = std::fopen(tmp.c_str(), "wb");
+    if (!f) throw Error(path + ": cannot write: " + std::strerror(errno));
+    bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    ok = (std::fflush(f) == 0) && ok;
+    ok = (std::fclose(f) == 0) && ok;
+    if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
+        int e = errno;
+        std::remove(tmp.c_str());
+        throw Error(path + ": cannot write: " + std::strerror(e));
+    }
+}
+
+void save_camera_calibration(const std::string &path, const cyl_camera &cam, bool with_mount,
+                             const std::string &comment)
+{
+    cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
     fs << "image_width" << (int)cam.width << "image_height" << (int)cam.height;
     cv::Mat K = (cv::Mat_<double>(3, 3) << cam.fx_px, 0, cam.cx_px, 0, cam.fy_px, cam.cy_px, 0, 0, 1);
     cv::Mat D = (cv::Mat_<double>(1, 5) << cam.k1, cam.k2, cam.p1, cam.p2, cam.k3);
     fs << "camera_matrix" << K << "distortion_coefficients" << D;
-    cv::Mat C(CYL_INTR_COUNT, CYL_INTR_COUNT, CV_64F);
-    for (int i = 0; i < CYL_INTR_COUNT; i++)
-        for (int j = 0; j < CYL_INTR_COUNT; j++) C.at<double>(i, j) = cam.intr_cov[i][j];
-    fs << "intrinsic_covariance" << C;
-    fs << "mount_tilt_deg" << cam.tilt_rad / kDeg << "mount_yaw_deg" << cam.yaw_rad / kDeg
-       << "mount_height_m" << cam.height_m << "mount_offset_m" << cam.offset_m;
-    fs << "mount_tilt_sigma_deg" << cam.tilt_sigma_rad / kDeg << "mount_yaw_sigma_deg" << cam.yaw_sigma_rad / kDeg
-       << "mount_height_sigma_m" << cam.height_sigma_m << "mount_offset_sigma_m" << cam.offset_sigma_m;
+    if (!(cam.flags & CYL_CAM_INTR_COV_UNKNOWN)) {
+        cv::Mat C(CYL_INTR_COUNT, CYL_INTR_COUNT, CV_64F);
+        for (int i = 0; i < CYL_INTR_COUNT; i++)
+            for (int j = 0; j < CYL_INTR_COUNT; j++) C.at<double>(i, j) = cam.intr_cov[i][j];
+        fs << "intrinsic_covariance" << C;
+    }
+    if (with_mount) {
+        fs << "mount_tilt_deg" << cam.tilt_rad / kDeg << "mount_yaw_deg" << cam.yaw_rad / kDeg
+           << "mount_height_m" << cam.height_m << "mount_offset_m" << cam.offset_m;
+        fs << "mount_tilt_sigma_deg" << cam.tilt_sigma_rad / kDeg << "mount_yaw_sigma_deg"
+           << cam.yaw_sigma_rad / kDeg << "mount_height_sigma_m" << cam.height_sigma_m << "mount_offset_sigma_m"
+           << cam.offset_sigma_m;
+    }
+    std::string text = fs.releaseAndGetString(), lines;
+    std::istringstream is(comment);
+    for (std::string line; std::getline(is, line);) lines += "# " + line + "\n";
+    size_t pos = text.find("---\n");
+    if (pos != std::string::npos) text.insert(pos + 4, lines);
+    write_file_atomic(path, text);
 }
 
 } // namespace cylfe

@@ -230,21 +230,12 @@ def read_obslog(path, skip_bad=False) -> Dataset:
         where = f"{path}:{lineno}"
         last_unterminated = truncated_tail and i == n - 1
         try:
-            text = bline.decode("utf-8")
-        except UnicodeDecodeError as e:
-            err = ObsLogError(f"{where}: not UTF-8 ({e.reason} at byte {e.start})")
-            if last_unterminated:
-                notes.append(f"ignored the truncated last line {where} (interrupted writer?)")
-                break
-            if skip_bad and header is not None:
-                skipped.append(str(err))
-                if b.cur is not None:
-                    b.cur["had_skips"] = True
+            try:
+                text = bline.decode("utf-8")
+            except UnicodeDecodeError as e:
+                raise ObsLogError(f"{where}: not UTF-8 ({e.reason} at byte {e.start})")
+            if not text.strip():
                 continue
-            raise err
-        if not text.strip():
-            continue
-        try:
             try:
                 rec = json.loads(text)
             except json.JSONDecodeError as e:

@@ -20,6 +20,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "cylfe/calibration.hpp"
+
 extern "C" {
 #include "cyl/camera.h"
 #include "cyl/colortable.h"
@@ -182,12 +184,10 @@ void save_table(const std::string &path, const cyl_colortable &t);
 
 // ---- files -------------------------------------------------------------------------------------
 
-// Write text to path through "<path>.tmp.<pid>" and rename; throws Error naming the file.
-void write_file_atomic(const std::string &path, const std::string &text);
-// OpenCV FileStorage YAML with libcyl's fields (cylfe::save_camera_calibration, made atomic),
-// preceded by comment lines (each line of `comment` gets a "# "). with_mount = false leaves the
-// mount_* fields out (an intrinsic calibration: the mount is then unknown when read back); the
-// intrinsic covariance is left out when cam.flags has CYL_CAM_INTR_COV_UNKNOWN (both writers).
+// Write text to path through "<path>.tmp.<pid>" and rename (cylfe::write_file_atomic).
+using cylfe::write_file_atomic;
+// OpenCV FileStorage YAML with libcyl's fields: cylfe::save_camera_calibration (atomic; unknown
+// mount and intrinsic covariance left out; comment lines after the header).
 void save_opencv_yaml(const std::string &path, const cyl_camera &cam, const std::string &comment = "",
                       bool with_mount = true);
 // ROS camera_info YAML (camera_calibration's layout) with the same extra fields.

@@ -41,7 +41,15 @@ struct CameraCalibration {
 // YAML, a missing or malformed required field, or an invalid camera (cyl_camera_check).
 CameraCalibration load_camera_calibration(const std::string &path);
 
-// Write cam as OpenCV FileStorage YAML with the libcyl fields (always all of them).
-void save_camera_calibration(const std::string &path, const cyl_camera &cam);
+// Write cam as OpenCV FileStorage YAML with libcyl's fields, through "<path>.tmp.<pid>" renamed
+// into place (a good file is never replaced by a partial one). The intrinsic covariance is left
+// out when cam.flags has CYL_CAM_INTR_COV_UNKNOWN, the mount_* fields when with_mount is false (an
+// intrinsic calibration: the mount is unknown when read back). Each line of `comment` becomes a
+// "# " line after the YAML header. Throws Error naming the file.
+void save_camera_calibration(const std::string &path, const cyl_camera &cam, bool with_mount = true,
+                             const std::string &comment = "");
+
+// Write text to path through "<path>.tmp.<pid>" and rename; throws Error naming the file.
+void write_file_atomic(const std::string &path, const std::string &text);
 
 } // namespace cylfe

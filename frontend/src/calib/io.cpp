@@ -20,7 +20,6 @@ namespace calib {
 namespace {
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
-std::string tmp_name(const std::string &path) { return path + ".tmp." + std::to_string(getpid()); }
 
 std::string read_all(const std::string &path)
 {
@@ -57,52 +56,9 @@ std::string ros_matrix(const std::string &name, int rows, int cols, const double
 }
 } // namespace
 
-void write_file_atomic(const std::string &path, const std::string &text)
-{
-    std::string tmp = tmp_name(path);
-    FILE *f = std::fopen(tmp.c_str(), "wb");
-    if (!f) throw Error(path + ": cannot write: " + std::strerror(errno));
-    bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    ok = (std::fflush(f) == 0) && ok;
-    ok = (std::fclose(f) == 0) && ok;
-    if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
-        int e = errno;
-        std::remove(tmp.c_str());
-        throw Error(path + ": cannot write: " + std::strerror(e));
-    }
-}
-
 void save_opencv_yaml(const std::string &path, const cyl_camera &cam, const std::string &comment, bool with_mount)
 {
-    // cylfe::save_camera_calibration writes the file itself: let it write a temporary file,
-    // add the comment after the YAML header, then rename it through write_file_atomic.
-    std::string tmp = tmp_name(path) + ".yaml";
-    std::string text;
-    try {
-        save_camera_calibration(tmp, cam);
-        text = read_all(tmp);
-    } catch (...) {
-        std::remove(tmp.c_str());
-        throw;
-    }
-    std::remove(tmp.c_str());
-    // leave out what is unknown: the mount (with_mount false), the intrinsic covariance (flag)
-    const bool no_cov = (cam.flags & CYL_CAM_INTR_COV_UNKNOWN) != 0;
-    if (!with_mount || no_cov) {
-        std::istringstream is(text);
-        std::string line, kept;
-        bool in_cov = false;
-        while (std::getline(is, line)) {
-            bool top = !line.empty() && line[0] != ' ';
-            if (top) in_cov = no_cov && line.rfind("intrinsic_covariance:", 0) == 0;
-            if (in_cov || (!with_mount && line.rfind("mount_", 0) == 0)) continue;
-            kept += line + "\n";
-        }
-        text = kept;
-    }
-    size_t pos = text.find("---\n");
-    if (pos != std::string::npos && !comment.empty()) text.insert(pos + 4, commented(comment));
-    write_file_atomic(path, text);
+    save_camera_calibration(path, cam, with_mount, comment);
 }
 
 std::string ros_yaml(const cyl_camera &cam, const std::string &camera_name, const std::string &comment,
