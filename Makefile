@@ -33,6 +33,8 @@ DEBS_CV    := libopencv-dev libyaml-cpp-dev
 DEBS_BENCH := valgrind
 
 STAMP := $(BUILD)/.stamps
+# The project-local Python venv (mk/slam.mk creates it; the Python fuzz target adds atheris)
+VENV := .venv
 deps-build := $(STAMP)/debs-build
 $(STAMP):
 	mkdir -p $@
@@ -112,3 +114,9 @@ bench: $(BUILD)/bench_segment $(BUILD)/bench_uncertainty $(BUILD)/bench_replay $
 
 clean:
 	rm -rf $(BUILD) libcyl/build
+
+# Issue 8's hardening checks (sanitizers, firmware + armhf, fuzz smoke, lint, soak), one after
+# another; .ci/run runs them after `make test`.
+ci-hardening:
+	scripts/ci-hardening.sh
+.PHONY: ci-hardening

@@ -7,7 +7,7 @@ FUZZ_SECONDS ?= 60
 FUZZ_DIR := build/fuzz
 FUZZ_FLAGS := -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all
 FUZZ_LIB := libcyl/build/fuzz/libcyl.a
-FUZZ_TARGETS := fuzz_table fuzz_detect fuzz_rawlog fuzz_calib
+FUZZ_TARGETS := fuzz_table fuzz_detect fuzz_rawlog fuzz_calib fuzz_obslog
 
 $(FUZZ_LIB): $(wildcard libcyl/src/*.c libcyl/src/*.h libcyl/include/cyl/*.h) $(STAMP)/debs-fuzz
 	$(MAKE) -C libcyl BUILD=build/fuzz CC=clang \
@@ -19,6 +19,13 @@ $(FUZZ_DIR)/%: tests/fuzz/%.cpp $(FUZZ_LIB) frontend/src/rawlog.cpp frontend/src
 	@mkdir -p $(dir $@)
 	clang++ -std=c++17 $(FUZZ_FLAGS) -Ilibcyl/include -Ifrontend/include $(CV_FLAGS) $< \
 	  frontend/src/rawlog.cpp frontend/src/calibration.cpp -o $@ $(FUZZ_LIB) $(CV_LIBS) -lm
+
+# The observation-log reader is Python (slam_demo/cylslam/obslog.py): its target runs under atheris,
+# libFuzzer's engine for Python, installed into the project venv.
+$(FUZZ_DIR)/fuzz_obslog: tests/fuzz/fuzz_obslog.py tests/fuzz/requirements.txt $(VENV)/.stamp
+	$(VENV)/bin/pip install -q -r tests/fuzz/requirements.txt
+	@mkdir -p $(dir $@)
+	touch $@
 
 fuzz-build: $(addprefix $(FUZZ_DIR)/,$(FUZZ_TARGETS))
 fuzz-smoke fuzz: fuzz-build

@@ -9,7 +9,6 @@
 
 DEBS_PY    := python3-venv python3-pip
 PYTHON3    ?= python3
-VENV       := .venv
 VENV_PY    := $(VENV)/bin/python
 MRCLAM_DIR ?= ../shared/data/mrclam/MRCLAM_Dataset7
 SLAM_OUT   ?= out/slam

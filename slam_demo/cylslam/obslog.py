@@ -214,8 +214,16 @@ class _Builder:
 
 def read_obslog(path, skip_bad=False) -> Dataset:
     """Read an observation log into a Dataset. Raises ObsLogError (strict) or skips bad lines."""
-    with open(path, "rb") as fh:
-        raw = fh.read()
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except OSError as e:
+        raise ObsLogError(f"{path}: cannot read ({e.strerror})") from None
+    return parse_obslog(raw, path, skip_bad)
+
+
+def parse_obslog(raw: bytes, path="<bytes>", skip_bad=False) -> Dataset:
+    """Parse the bytes of an observation log; `path` only names it in messages."""
     lines = raw.split(b"\n")
     truncated_tail = bool(lines and lines[-1] != b"")
     if not truncated_tail:
@@ -251,6 +259,7 @@ def read_obslog(path, skip_bad=False) -> Dataset:
                 if rec.get("version") != VERSION:
                     raise ObsLogError(f"{where}: unsupported version {rec.get('version')!r} "
                                       f"(this reader knows version {VERSION})")
+                _check_header(rec, where)
                 header = rec
                 continue
             b.record(rec, where, lineno)
@@ -286,13 +295,25 @@ def read_obslog(path, skip_bad=False) -> Dataset:
                  classes=list(classes), notes=notes, known_ids=known)
     ds.n_skipped = len(skipped)
     ds.header = header
-    cc = (header.get("camera") or {}).get("calib_cov")
-    ds.calib_cov = None
-    if isinstance(cc, list) and len(cc) == 64 and all(isinstance(x, (int, float)) and math.isfinite(x) for x in cc):
-        m = np.array(cc, float).reshape(8, 8)
-        if np.allclose(m, m.T) and np.all(np.linalg.eigvalsh(m) >= -1e-15):
-            ds.calib_cov = m
+    cc = header.get("camera", {}).get("calib_cov")
+    ds.calib_cov = None if cc is None else np.array(cc, float).reshape(8, 8)
     return ds
+
+
+def _check_header(rec, where):
+    """The header's optional fields have the types docs/formats.md gives them (checked once here,
+    so that nothing downstream meets a string where it expects an object)."""
+    if "source" in rec and not isinstance(rec["source"], str):
+        raise ObsLogError(f"{where}: header field 'source' must be a string")
+    cl = rec.get("classes")
+    if cl is not None and (not isinstance(cl, list) or not all(isinstance(c, str) for c in cl)):
+        raise ObsLogError(f"{where}: header field 'classes' must be a list of strings")
+    cam = rec.get("camera", {})
+    if not isinstance(cam, dict):
+        raise ObsLogError(f"{where}: header field 'camera' must be an object")
+    if cam.get("calib_cov") is not None:
+        m = np.array(_numlist(cam, "calib_cov", 64, where), float).reshape(8, 8)
+        _check_cov(m, where, "camera.calib_cov")
 
 
 class _Fatal(ObsLogError):

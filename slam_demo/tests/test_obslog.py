@@ -65,6 +65,30 @@ def test_each_malformed_kind(tmp_path, line, msg):
     assert str(e.value).startswith(f"{p}:")
 
 
+@pytest.mark.parametrize("fields,msg", [
+    ('"camera":"truth_landmark"', "header field 'camera' must be an object"),   # fuzz_obslog finding
+    ('"camera":null', "header field 'camera' must be an object"),
+    ('"classes":"orange"', "header field 'classes' must be a list of strings"),
+    ('"source":7', "header field 'source' must be a string"),
+    ('"camera":{"calib_cov":[1,2,3]}', "'calib_cov' must be a list of 64 finite numbers"),
+    ('"camera":{"calib_cov":[%s]}' % ",".join(["-1"] + ["0"] * 63),
+     "camera.calib_cov covariance is not positive semi-definite"),
+])
+def test_header_fields_checked(tmp_path, fields, msg):
+    # each of these used to be silently ignored or to raise a bare AttributeError downstream
+    p = tmp_path / "hdr.jsonl"
+    p.write_text('{"type":"header","format":"cyl-observations","version":1,' + fields + '}\n'
+                 '{"type":"frame","seq":0,"t":0}\n')
+    with pytest.raises(ObsLogError) as e:
+        read_obslog(str(p))
+    assert str(e.value).startswith(f"{p}:1: ") and msg in str(e.value)
+
+
+def test_missing_file_is_an_obslog_error(tmp_path):
+    with pytest.raises(ObsLogError, match=r"nope.jsonl: cannot read"):
+        read_obslog(str(tmp_path / "nope.jsonl"))
+
+
 def test_header_version_and_format_checked(tmp_path):
     p = tmp_path / "v2.jsonl"
     p.write_text('{"type":"header","format":"cyl-observations","version":2}\n')

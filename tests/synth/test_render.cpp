@@ -63,6 +63,45 @@ TEST(SynthRender, DeterministicForASeed)
     EXPECT_EQ(frames, 3);
 }
 
+// The source generates its drive step by step (constant memory, `make soak`); it must give
+// exactly the steps make_drive gives all at once.
+TEST(SynthRender, SourceDriveEqualsMakeDrive)
+{
+    Scene s = default_scene();
+    s.camera.width = 64;  // small frames: this test is about the drive, not the pixels
+    s.camera.height = 48;
+    const uint32_t n = 40;
+    std::vector<DriveStep> d = make_drive(s, n, 9);
+    SyntheticSource src(s, n, 9);
+    SourceEvent ev;
+    size_t k_odo = 0, k_pose = 0, k_frame = 0;
+    while (src.next(ev)) {
+        if (ev.kind == RecordType::Frame) {
+            ASSERT_LT(k_frame, d.size());
+            EXPECT_EQ(ev.header.seq, d[k_frame].seq);
+            EXPECT_EQ(ev.header.t_ns, d[k_frame].t_ns);
+            k_frame++;
+        } else if (ev.kind == RecordType::Odometry) {
+            ASSERT_LT(k_odo, d.size());
+            EXPECT_EQ(ev.odometry.dx_m, d[k_odo].odo.dx_m) << "step " << k_odo;
+            EXPECT_EQ(ev.odometry.dy_m, d[k_odo].odo.dy_m) << "step " << k_odo;
+            EXPECT_EQ(ev.odometry.dtheta_rad, d[k_odo].odo.dtheta_rad) << "step " << k_odo;
+            for (int i = 0; i < 6; i++) EXPECT_EQ(ev.odometry.cov[i], d[k_odo].odo.cov[i]);
+            k_odo++;
+        } else if (ev.kind == RecordType::TruthPose) {
+            ASSERT_LT(k_pose, d.size());
+            EXPECT_EQ(ev.truth_pose.x_m, d[k_pose].truth.x);
+            EXPECT_EQ(ev.truth_pose.theta_rad, d[k_pose].truth.theta);
+            k_pose++;
+        }
+    }
+    EXPECT_EQ(k_frame, n);
+    EXPECT_EQ(k_odo, n);
+    EXPECT_EQ(k_pose, n);
+    // odometry noise is really drawn (not all-zero errors)
+    EXPECT_NE(d[5].odo.dx_m, d[5].true_dx);
+}
+
 TEST(SynthRender, SourceEventOrderAndInfo)
 {
     Scene s = default_scene();

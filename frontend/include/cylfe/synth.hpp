@@ -188,6 +188,7 @@ bool undistort(const CameraModel &cam, double xd, double yd, double *x, double *
 struct CleanFrame {
     uint32_t width = 0, height = 0;
     std::vector<float> y, u, v;
+    std::vector<float> scratch;  // the blur's workspace: reusing a CleanFrame reuses all its memory
 };
 
 class Renderer {
@@ -230,6 +231,22 @@ Pose2 trajectory_pose(const TrajectoryParams &p, double dist_m);
 void pose_between(const Pose2 &a, const Pose2 &b, double *dx, double *dy, double *dth);
 // Covariance (upper triangle xx xy xt yy yt tt) of the odometry error for a true increment.
 void odometry_covariance(const OdometryNoise &n, double dx, double dy, double dth, double cov[6]);
+// The drive, generated one step at a time in constant memory (steps 0, 1, 2, ...; the same
+// sequence as make_drive for the same scene and seed).
+class DriveGenerator {
+public:
+    DriveGenerator(const Scene &s, uint64_t seed);  // throws Error on a bad trajectory
+    DriveStep next();
+    uint64_t steps_done() const { return k_; }
+
+private:
+    TrajectoryParams tp_;
+    OdometryNoise noise_;
+    uint64_t rng_;       // state of the odometry-noise stream
+    Pose2 prev_{};
+    uint64_t k_ = 0;
+};
+// The first `frames` steps of the drive (tests and experiments that want them all at once).
 std::vector<DriveStep> make_drive(const Scene &s, uint32_t frames, uint64_t seed);
 
 // The synthetic scene as a cylfe::Source: TruthLandmark events (one per landmark) first, then
@@ -240,18 +257,20 @@ public:
     const StreamInfo &info() const override { return info_; }
     bool next(SourceEvent &ev) override;
     double progress() const override;
-    const std::vector<DriveStep> &drive() const { return drive_; }
     const Renderer &renderer() const { return renderer_; }
 
 private:
     Scene scene_;
     Renderer renderer_;
     uint64_t seed_;
-    std::vector<DriveStep> drive_;
+    DriveGenerator drive_;   // constant memory however many frames (make soak)
+    uint64_t frames_;
+    DriveStep cur_;          // the step being emitted (frame, odometry, truth pose)
     std::vector<TruthLandmark> landmarks_;
     StreamInfo info_;
     size_t lm_next_ = 0, step_ = 0;
     int phase_ = 0;  // 0 frame, 1 odometry, 2 truth pose
+    CleanFrame clean_;             // reused frame to frame (constant memory)
     std::vector<uint8_t> frame_;
 };
 

@@ -108,42 +108,53 @@ void odometry_covariance(const OdometryNoise &n, double dx, double dy, double dt
     cov[5] = st * st;                            // tt
 }
 
+DriveGenerator::DriveGenerator(const Scene &s, uint64_t seed)
+    : tp_(s.trajectory), noise_(s.odometry), rng_(mix_seed(seed, 0x0D0Du, 1))
+{
+    if (tp_.fps <= 0 || tp_.speed_mps < 0) throw Error("synthetic scene: trajectory fps must be > 0 and speed >= 0");
+}
+
+DriveStep DriveGenerator::next()
+{
+    DriveStep st;
+    const uint64_t k = k_++;
+    st.seq = k;
+    double t = (double)k / tp_.fps;
+    st.t_ns = (int64_t)std::llround(t * 1e9);
+    st.truth = trajectory_pose(tp_, tp_.speed_mps * t);
+    if (k == 0) {
+        odometry_covariance(noise_, 0, 0, 0, st.odo.cov);
+    } else {
+        Gauss g(rng_);
+        pose_between(prev_, st.truth, &st.true_dx, &st.true_dy, &st.true_dtheta);
+        odometry_covariance(noise_, st.true_dx, st.true_dy, st.true_dtheta, st.odo.cov);
+        double d = std::hypot(st.true_dx, st.true_dy);
+        double phi = d > 1e-12 ? std::atan2(st.true_dy, st.true_dx) : 0.0;
+        double sl = noise_.k_long * d + noise_.min_xy, sa = noise_.k_lat * d + noise_.min_xy;
+        double sth = std::sqrt(st.odo.cov[5]);
+        double el = sl * g(), ea = sa * g(), et = sth * g();
+        rng_ = g.st;
+        st.odo.dx_m = st.true_dx + std::cos(phi) * el - std::sin(phi) * ea;
+        st.odo.dy_m = st.true_dy + std::sin(phi) * el + std::cos(phi) * ea;
+        st.odo.dtheta_rad = st.true_dtheta + et;
+    }
+    prev_ = st.truth;
+    return st;
+}
+
 std::vector<DriveStep> make_drive(const Scene &s, uint32_t frames, uint64_t seed)
 {
-    const TrajectoryParams &tp = s.trajectory;
-    if (tp.fps <= 0 || tp.speed_mps < 0) throw Error("synthetic scene: trajectory fps must be > 0 and speed >= 0");
-    std::vector<DriveStep> out(frames);
-    Gauss g(mix_seed(seed, 0x0D0Du, 1));
-    Pose2 prev{};
-    for (uint32_t k = 0; k < frames; k++) {
-        DriveStep &st = out[k];
-        st.seq = k;
-        double t = k / tp.fps;
-        st.t_ns = (int64_t)std::llround(t * 1e9);
-        st.truth = trajectory_pose(tp, tp.speed_mps * t);
-        if (k == 0) {
-            odometry_covariance(s.odometry, 0, 0, 0, st.odo.cov);
-        } else {
-            pose_between(prev, st.truth, &st.true_dx, &st.true_dy, &st.true_dtheta);
-            odometry_covariance(s.odometry, st.true_dx, st.true_dy, st.true_dtheta, st.odo.cov);
-            double d = std::hypot(st.true_dx, st.true_dy);
-            double phi = d > 1e-12 ? std::atan2(st.true_dy, st.true_dx) : 0.0;
-            double sl = s.odometry.k_long * d + s.odometry.min_xy, sa = s.odometry.k_lat * d + s.odometry.min_xy;
-            double sth = std::sqrt(st.odo.cov[5]);
-            double el = sl * g(), ea = sa * g(), et = sth * g();
-            st.odo.dx_m = st.true_dx + std::cos(phi) * el - std::sin(phi) * ea;
-            st.odo.dy_m = st.true_dy + std::sin(phi) * el + std::cos(phi) * ea;
-            st.odo.dtheta_rad = st.true_dtheta + et;
-        }
-        prev = st.truth;
-    }
+    DriveGenerator gen(s, seed);
+    std::vector<DriveStep> out;
+    out.reserve(frames);
+    for (uint32_t k = 0; k < frames; k++) out.push_back(gen.next());
     return out;
 }
 
 // ---- SyntheticSource ----------------------------------------------------------------------
 
 SyntheticSource::SyntheticSource(const Scene &s, uint32_t frames, uint64_t seed)
-    : scene_(s), renderer_(s), seed_(seed), drive_(make_drive(s, frames, seed))
+    : scene_(s), renderer_(s), seed_(seed), drive_(s, seed), frames_(frames)
 {
     for (const Cylinder &c : scene_.cylinders) {
         if (!c.landmark) continue;
@@ -165,7 +176,7 @@ SyntheticSource::SyntheticSource(const Scene &s, uint32_t frames, uint64_t seed)
 
 double SyntheticSource::progress() const
 {
-    return drive_.empty() ? 1.0 : (double)step_ / (double)drive_.size();
+    return frames_ == 0 ? 1.0 : (double)step_ / (double)frames_;
 }
 
 bool SyntheticSource::next(SourceEvent &ev)
@@ -180,13 +191,15 @@ bool SyntheticSource::next(SourceEvent &ev)
         ev.truth_landmark = landmarks_[lm_next_++];
         return true;
     }
-    if (step_ >= drive_.size()) return false;
-    const DriveStep &st = drive_[step_];
+    if (step_ >= frames_) return false;
+    if (phase_ == 0) cur_ = drive_.next();  // step_ == cur_.seq from here to the truth pose
+    const DriveStep &st = cur_;
     ev.header.seq = st.seq;
     ev.header.t_ns = st.t_ns;
     if (phase_ == 0) {
         double gain = renderer_.frame_gain(seed_, st.seq, st.t_ns * 1e-9);
-        renderer_.render_yuyv(st.truth, gain, mix_seed(seed_, st.seq, 0x5EED), frame_);
+        renderer_.render_clean(st.truth, gain, clean_);
+        renderer_.finish_yuyv(clean_, mix_seed(seed_, st.seq, 0x5EED), frame_);
         ev.kind = RecordType::Frame;
         ev.header.type = ev.kind;
         ev.header.size = (uint32_t)frame_.size();

@@ -93,10 +93,11 @@ void gaussian_kernel(double sigma, std::vector<float> &k)
 }
 
 // Separable convolution with clamped borders; horizontal kernel kh, vertical kv.
+// tmp: scratch, reused across calls (no per-frame allocation of a plane)
 void blur_plane(std::vector<float> &p, uint32_t w, uint32_t h, const std::vector<float> &kh,
-                const std::vector<float> &kv)
+                const std::vector<float> &kv, std::vector<float> &tmp)
 {
-    std::vector<float> tmp(p.size());
+    tmp.resize(p.size());
     int rh = (int)kh.size() / 2, rv = (int)kv.size() / 2;
     if (rh > 0) {
         std::vector<float> pad(w + 2 * rh);
@@ -477,9 +478,9 @@ void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out) co
     std::vector<float> k_opt, k_chr;
     gaussian_kernel(im.blur_sigma_px, k_opt);
     gaussian_kernel(std::sqrt(im.blur_sigma_px * im.blur_sigma_px + im.chroma_blur_px * im.chroma_blur_px), k_chr);
-    blur_plane(out.y, W, H, k_opt, k_opt);
-    blur_plane(out.u, W, H, k_chr, k_opt);
-    blur_plane(out.v, W, H, k_chr, k_opt);
+    blur_plane(out.y, W, H, k_opt, k_opt, out.scratch);
+    blur_plane(out.u, W, H, k_chr, k_opt, out.scratch);
+    blur_plane(out.v, W, H, k_chr, k_opt, out.scratch);
 }
 
 void Renderer::finish_yuyv(const CleanFrame &cf, uint64_t noise_seed, std::vector<uint8_t> &out) const
