@@ -54,7 +54,7 @@ while True:
         if c not in seen and frames >= c:
             seen[c] = (frames, h, time.time() - t0)
     bar = int(30 * frames / n2)
-    print(f"\rsoak [{'#' * bar}{'.' * (30 - bar)}] {frames}/{n2} frames, peak RSS {h / 1024:.1f} MB",
+    print(f"\rsoak [{'#' * bar}{'.' * (30 - bar)}] {frames}/{n2} frames, peak RSS {h / 1024:.1f} MiB",
           end="", file=sys.stderr, flush=True)
 print(file=sys.stderr)
 rc = p.returncode

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # V4L2 against a real driver: boot Debian's own kernel under qemu (software emulation), load
-# the kernel's vivid driver from a small initramfs and run the static test program
-# build/vivid_test inside. The kernel package is fetched with apt-get download (Debian's
+# the kernel's vivid driver from a small initramfs and run the test program build/vivid_test
+# inside (static; or dynamic with its libraries copied in, as `make test SAN=1` builds it). The kernel package is fetched with apt-get download (Debian's
 # registry) into build/vivid/kcache once; its modules are never installed on the host.
 # Fails loudly (non-zero exit, the reason printed) whenever the test cannot run.
 set -euo pipefail
@@ -54,11 +54,24 @@ R=$W/initrd; rm -rf "$R"; mkdir -p "$R"/{bin,dev,proc,sys,tmp,lib/modules}
 cp /bin/busybox "$R/bin/"
 for a in sh mount insmod cat cut sleep poweroff; do ln -s busybox "$R/bin/$a"; done
 cp "$TEST" "$R/bin/vivid_test"
+# A dynamically linked test (make test SAN=1: the sanitizer runtimes are shared libraries) gets
+# its libraries and loader copied in at their host paths, and the sanitizer options passed on.
+if readelf -d "$TEST" 2>/dev/null | grep -q '(NEEDED)'; then
+  for lib in $(ldd "$TEST" | awk '$2 == "=>" && $3 ~ /^\// {print $3} $1 ~ /^\// {print $1}'); do
+    mkdir -p "$R$(dirname "$lib")"
+    cp -L "$lib" "$R$lib"
+  done
+fi
+: > "$R/env"
+for v in ASAN_OPTIONS UBSAN_OPTIONS; do
+  if [ -n "${!v:-}" ]; then printf 'export %s=%q\n' "$v" "${!v}" >> "$R/env"; fi
+done
 cp "$C"/mod/*.ko "$R/lib/modules/"
 cp "$C/modules.order" "$R/"
 cat > "$R/init" <<'INIT'
 #!/bin/sh
 export PATH=/bin
+. /env
 mount -t proc proc /proc; mount -t sysfs sys /sys; mount -t devtmpfs dev /dev; mount -t tmpfs tmp /tmp
 for m in $(cat /modules.order); do
   opts=""; [ "$m" = vivid.ko ] && opts="n_devs=1"
