@@ -61,7 +61,8 @@ $(BUILD)/bench_replay: bench/bench_replay.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
 TEST_EXTRA += $(BUILD)/cyl
 TEST_EXTRA_BINS += tests/frontend/test_cli.sh:$(BUILD)/cyl
 
-# ---- make soak: 10,000 synthetic frames, peak memory equal to a 1,000-frame run (issue 8) ------
+# ---- make soak: 10,000 synthetic frames in one process; peak RSS at the end must equal its
+# peak at frame 1,000 (issue 8; scripts/soak.sh) ----------------------------------------------
 soak: $(BUILD)/cyl
 	@BUILD=$(BUILD) scripts/soak.sh
 .PHONY: soak

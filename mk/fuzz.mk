@@ -22,12 +22,12 @@ $(FUZZ_DIR)/%: tests/fuzz/%.cpp $(FUZZ_LIB) frontend/src/rawlog.cpp frontend/src
 
 # The observation-log reader is Python (slam_demo/cylslam/obslog.py): its target runs under atheris,
 # libFuzzer's engine for Python, installed into the project venv.
-$(FUZZ_DIR)/fuzz_obslog: tests/fuzz/fuzz_obslog.py tests/fuzz/requirements.txt $(VENV)/.stamp
+$(FUZZ_DIR)/fuzz_obslog: tests/fuzz/fuzz_obslog.py tests/fuzz/requirements.txt $(VENV)/.stamp $(STAMP)/debs-fuzz
 	$(VENV)/bin/pip install -q -r tests/fuzz/requirements.txt
 	@mkdir -p $(dir $@)
 	touch $@
 
 fuzz-build: $(addprefix $(FUZZ_DIR)/,$(FUZZ_TARGETS))
 fuzz-smoke fuzz: fuzz-build
-	scripts/fuzz.sh $(FUZZ_SECONDS) $(FUZZ_TARGETS)
+	VENV=$(VENV) scripts/fuzz.sh $(FUZZ_SECONDS) $(FUZZ_TARGETS)
 .PHONY: fuzz fuzz-smoke fuzz-build

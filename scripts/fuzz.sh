@@ -11,7 +11,7 @@ for t in "$@"; do
   [ -d "tests/fuzz/corpus/$t" ] && cp -n tests/fuzz/corpus/$t/* "$work/" 2>/dev/null
   log="$D/$t.log"
   # a Python target (tests/fuzz/NAME.py, atheris in the project venv) or a compiled one
-  if [ -f "tests/fuzz/$t.py" ]; then cmd=(.venv/bin/python "tests/fuzz/$t.py"); else cmd=("$D/$t"); fi
+  if [ -f "tests/fuzz/$t.py" ]; then cmd=("${VENV:-.venv}/bin/python" "tests/fuzz/$t.py"); else cmd=("$D/$t"); fi
   dict=(); [ -f "tests/fuzz/$t.dict" ] && dict=(-dict="tests/fuzz/$t.dict")
   "${cmd[@]}" "$work" "${dict[@]}" -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
       -artifact_prefix="$D/findings/$t-" >"$log" 2>&1

@@ -9,6 +9,7 @@ set -euo pipefail
 B=${BUILD:-build}
 N1=${SOAK_SMALL:-1000}; N2=${SOAK_LARGE:-10000}
 TOL=${SOAK_TOLERANCE:-1.005}   # allowed peak ratio (end / frame N1): page-granular noise only
+[ "$N1" -ge 1 ] && [ "$N2" -gt "$N1" ] || { echo "soak: need 1 <= SOAK_SMALL < SOAK_LARGE (got $N1, $N2)" >&2; exit 2; }
 mkdir -p "$B/soak"
 python3 - "$B/cyl" "$N1" "$N2" "$TOL" "$B/soak/soak.jsonl" <<'PY'
 import json, os, subprocess, sys, time
@@ -66,6 +67,7 @@ end_kib = max(last_h, ru.ru_maxrss)
 n_out = sum(1 for line in open(log, "rb") if b'"type":"frame"' in line)
 if n_out != n2:
     sys.exit(f"soak: the log has {n_out} frames, expected {n2}")
+os.remove(log)   # checked; 10,000 frames of log are not worth keeping
 if n1 not in seen:
     sys.exit(f"soak: never saw frame {n1} in the log while the process ran")
 print(f"{'frames':>8} {'seconds':>8} {'peak RSS KiB':>13}")

@@ -56,7 +56,8 @@ for a in sh mount insmod cat cut sleep poweroff; do ln -s busybox "$R/bin/$a"; d
 cp "$TEST" "$R/bin/vivid_test"
 # A dynamically linked test (make test SAN=1: the sanitizer runtimes are shared libraries) gets
 # its libraries and loader copied in at their host paths, and the sanitizer options passed on.
-if readelf -d "$TEST" 2>/dev/null | grep -q '(NEEDED)'; then
+dyn=$(readelf -d "$TEST" 2>/dev/null || true)
+if grep -q '(NEEDED)' <<<"$dyn"; then
   for lib in $(ldd "$TEST" | awk '$2 == "=>" && $3 ~ /^\// {print $3} $1 ~ /^\// {print $1}'); do
     mkdir -p "$R$(dirname "$lib")"
     cp -L "$lib" "$R$lib"
@@ -96,4 +97,9 @@ qrc=${PIPESTATUS[0]}
 set -e
 grep -E '^(\[|  |VIVID)' "$log" || true
 grep -q '^VIVID-RESULT: rc=' "$log" || die "the test did not run in the VM (qemu exit $qrc; see $log)"
-grep -q '^VIVID-RESULT: rc=0$' "$log"
+if ! grep -q '^VIVID-RESULT: rc=0$' "$log"; then
+  # the console filter above hides sanitizer reports: show them
+  grep -aE '==[0-9]+==|SUMMARY|runtime error' "$log" | head -20 || true
+  echo "vivid-test: FAILED: $(grep '^VIVID-RESULT' "$log") (console log: $log)" >&2
+  exit 1
+fi

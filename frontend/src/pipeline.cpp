@@ -71,12 +71,13 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
 
 namespace {
 
-// A JSON number; non-finite values become null (JSON has no NaN).
-std::string num(double v)
+// A JSON number; non-finite values become null (JSON has no NaN). 10 significant digits for
+// measurements; 17 (exact round trip) where a reader re-checks a matrix's definiteness.
+std::string num(double v, int digits = 10)
 {
     if (!std::isfinite(v)) return "null";
-    char b[32];
-    std::snprintf(b, sizeof b, "%.10g", v);
+    char b[40];
+    std::snprintf(b, sizeof b, "%.*g", digits, v);
     return b;
 }
 
@@ -100,7 +101,7 @@ std::string calib_cov_json(const cyl_camera &c)
     for (int i = 0; i < CYL_CALIB_COUNT; i++)
         for (int j = 0; j < CYL_CALIB_COUNT; j++) {
             if (i || j) o += ",";
-            o += num(cc[i][j]);
+            o += num(cc[i][j], 17);  // a rank-deficient block must stay PSD after printing
         }
     return o;
 }

@@ -39,6 +39,14 @@ class ObsLogError(Exception):
     """A malformed observation log: message starts with FILE:LINE."""
 
 
+def _finite(v):
+    """True for a finite JSON number (an integer too large for a float is not)."""
+    try:
+        return math.isfinite(v)
+    except OverflowError:
+        return False
+
+
 def _num(rec, key, where, required=True, default=None):
     if key not in rec:
         if required:
@@ -47,7 +55,7 @@ def _num(rec, key, where, required=True, default=None):
     v = rec[key]
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise ObsLogError(f"{where}: field '{key}' must be a number, got {json.dumps(v)}")
-    if not math.isfinite(v):
+    if not _finite(v):
         raise ObsLogError(f"{where}: field '{key}' is not finite")
     return float(v)
 
@@ -79,16 +87,20 @@ def _str(rec, key, where):
 def _numlist(rec, key, n, where):
     v = rec.get(key)
     if (not isinstance(v, list) or len(v) != n or
-            not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)):
+            not all(isinstance(x, (int, float)) and not isinstance(x, bool) and _finite(x) for x in v)):
         raise ObsLogError(f"{where}: field {key!r} must be a list of {n} finite numbers")
     return [float(x) for x in v]
 
 
-def _check_cov(m, where, what):
+def _check_cov(m, where, what, rtol=1e-12):
+    """Symmetric and positive semi-definite: no eigenvalue below -rtol * max(1, largest)."""
     if not np.allclose(m, m.T):
         raise ObsLogError(f"{where}: {what} covariance is not symmetric")
-    ev = np.linalg.eigvalsh(m)
-    if ev.min() < -1e-12 * max(1.0, ev.max()):
+    with np.errstate(all="ignore"):
+        ev = np.linalg.eigvalsh(m)
+    if not np.all(np.isfinite(ev)):   # entries near 1e308: eigenvalues overflow
+        raise ObsLogError(f"{where}: {what} covariance is out of range")
+    if ev.min() < -rtol * max(1.0, ev.max()):
         raise ObsLogError(f"{where}: {what} covariance is not positive semi-definite "
                           f"(eigenvalues {ev.tolist()})")
 
@@ -99,6 +111,7 @@ class _Builder:
         self.steps = []
         self.truth_lm = {}
         self.cur = None          # dict of the frame being read
+        self.last_seq = None     # seq of the last frame line (frames without odom included)
         self.n_no_odom = 0
         self.n_first_odom = 0
         self.unknown_types = {}
@@ -139,9 +152,10 @@ class _Builder:
             t = _num(rec, "t", where)
             n_obs = _int(rec, "n_obs", where, required=False)
             self.flush_frame()
-            if self.steps and seq <= self.steps[-1].seq:
+            if self.last_seq is not None and seq <= self.last_seq:
                 raise ObsLogError(f"{where}: frame seq {seq} does not increase "
-                                  f"(previous {self.steps[-1].seq})")
+                                  f"(previous {self.last_seq})")
+            self.last_seq = seq
             self.cur = dict(seq=seq, t=t, n_obs=n_obs, obs=[], odom=None, truth=None,
                             line=lineno, had_skips=False)
         elif typ == "obs":
@@ -180,7 +194,7 @@ class _Builder:
             c = rec.get("cov")
             if (not isinstance(c, list) or len(c) != 6 or
                     not all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                            and math.isfinite(v) for v in c)):
+                            and _finite(v) for v in c)):
                 raise ObsLogError(f"{where}: field 'cov' must be a list of 6 finite numbers "
                                   "(xx xy xt yy yt tt)")
             xx, xy, xt, yy, yt, tt = c
@@ -229,6 +243,7 @@ def parse_obslog(raw: bytes, path="<bytes>", skip_bad=False) -> Dataset:
     if not truncated_tail:
         lines = lines[:-1]
     header = None
+    calib_cov = None
     b = _Builder(path)
     skipped = []
     notes = []
@@ -248,6 +263,10 @@ def parse_obslog(raw: bytes, path="<bytes>", skip_bad=False) -> Dataset:
                 rec = json.loads(text)
             except json.JSONDecodeError as e:
                 raise ObsLogError(f"{where}: not valid JSON ({e.msg} at column {e.colno})")
+            except ValueError as e:      # e.g. an integer of more than 4300 digits
+                raise ObsLogError(f"{where}: not valid JSON ({e})")
+            except RecursionError:
+                raise ObsLogError(f"{where}: not valid JSON (nested too deeply)")
             if not isinstance(rec, dict):
                 raise ObsLogError(f"{where}: not a JSON object")
             if header is None:
@@ -259,7 +278,7 @@ def parse_obslog(raw: bytes, path="<bytes>", skip_bad=False) -> Dataset:
                 if rec.get("version") != VERSION:
                     raise ObsLogError(f"{where}: unsupported version {rec.get('version')!r} "
                                       f"(this reader knows version {VERSION})")
-                _check_header(rec, where)
+                calib_cov = _check_header(rec, where)
                 header = rec
                 continue
             b.record(rec, where, lineno)
@@ -295,25 +314,31 @@ def parse_obslog(raw: bytes, path="<bytes>", skip_bad=False) -> Dataset:
                  classes=list(classes), notes=notes, known_ids=known)
     ds.n_skipped = len(skipped)
     ds.header = header
-    cc = header.get("camera", {}).get("calib_cov")
-    ds.calib_cov = None if cc is None else np.array(cc, float).reshape(8, 8)
+    ds.calib_cov = calib_cov
     return ds
 
 
 def _check_header(rec, where):
     """The header's optional fields have the types docs/formats.md gives them (checked once here,
-    so that nothing downstream meets a string where it expects an object)."""
+    so that nothing downstream meets a string where it expects an object). Returns the 8x8
+    camera.calib_cov, or None when absent. A null camera or calib_cov counts as absent."""
     if "source" in rec and not isinstance(rec["source"], str):
         raise ObsLogError(f"{where}: header field 'source' must be a string")
     cl = rec.get("classes")
     if cl is not None and (not isinstance(cl, list) or not all(isinstance(c, str) for c in cl)):
         raise ObsLogError(f"{where}: header field 'classes' must be a list of strings")
-    cam = rec.get("camera", {})
+    cam = rec.get("camera")
+    if cam is None:
+        return None
     if not isinstance(cam, dict):
         raise ObsLogError(f"{where}: header field 'camera' must be an object")
-    if cam.get("calib_cov") is not None:
-        m = np.array(_numlist(cam, "calib_cov", 64, where), float).reshape(8, 8)
-        _check_cov(m, where, "camera.calib_cov")
+    if cam.get("calib_cov") is None:
+        return None
+    m = np.array(_numlist(cam, "calib_cov", 64, where), float).reshape(8, 8)
+    # written with 17 digits; older logs have 10, which can tip a rank-deficient block (a fixed
+    # aspect ratio makes fx, fy fully correlated) a little below zero
+    _check_cov(m, where, "camera.calib_cov", rtol=1e-9)
+    return m
 
 
 class _Fatal(ObsLogError):

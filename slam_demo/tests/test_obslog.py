@@ -67,7 +67,6 @@ def test_each_malformed_kind(tmp_path, line, msg):
 
 @pytest.mark.parametrize("fields,msg", [
     ('"camera":"truth_landmark"', "header field 'camera' must be an object"),   # fuzz_obslog finding
-    ('"camera":null', "header field 'camera' must be an object"),
     ('"classes":"orange"', "header field 'classes' must be a list of strings"),
     ('"source":7', "header field 'source' must be a string"),
     ('"camera":{"calib_cov":[1,2,3]}', "'calib_cov' must be a list of 64 finite numbers"),
@@ -82,6 +81,47 @@ def test_header_fields_checked(tmp_path, fields, msg):
     with pytest.raises(ObsLogError) as e:
         read_obslog(str(p))
     assert str(e.value).startswith(f"{p}:1: ") and msg in str(e.value)
+
+
+def test_null_camera_and_calib_cov_count_as_absent(tmp_path):
+    for fields in ('"camera":null', '"camera":{"fx":500,"calib_cov":null}'):
+        p = tmp_path / "hdr.jsonl"
+        p.write_text('{"type":"header","format":"cyl-observations","version":1,' + fields + '}\n'
+                     '{"type":"frame","seq":0,"t":0}\n')
+        assert read_obslog(str(p)).calib_cov is None
+
+
+def test_calib_cov_rounded_rank_deficient_is_accepted(tmp_path):
+    # a fixed aspect ratio makes the fx/fy block rank 1; printed with 10 digits (older frontends)
+    # its smaller eigenvalue can come out slightly negative: still a valid prior
+    m = np.zeros((8, 8))
+    m[:2, :2] = np.outer([1.0, 1.0 / 0.9987], [1.0, 1.0 / 0.9987]) * 0.20839225
+    for i in range(2, 8):
+        m[i, i] = 1e-4
+    txt = ",".join("%.10g" % v for v in m.ravel())
+    assert np.linalg.eigvalsh(np.array([float(x) for x in txt.split(",")]).reshape(8, 8)).min() < 0
+    p = tmp_path / "cc.jsonl"
+    p.write_text('{"type":"header","format":"cyl-observations","version":1,"camera":{"calib_cov":['
+                 + txt + ']}}\n{"type":"frame","seq":0,"t":0}\n')
+    assert read_obslog(str(p)).calib_cov.shape == (8, 8)
+
+
+@pytest.mark.parametrize("line,msg", [
+    # found by review, not by the fuzzer: each used to escape as a bare Python exception
+    ('{"type":"frame","seq":0,"t":1' + "0" * 400 + '}', "field 't' is not finite"),        # OverflowError
+    ('{"type":"frame","seq":0,"t":1' + "0" * 5000 + '}', "not valid JSON"),                # ValueError
+    ("[" * 5000 + "]" * 5000, "not valid JSON"),                                           # RecursionError
+    ('{"type":"frame","seq":0,"t":0}\n{"type":"obs","seq":0,"t":0,"class":"orange","range_m":1,'
+     '"bearing_rad":0,"cov_rr":1.7e308,"cov_rb":1.7e308,"cov_bb":-1e307}', "out of range"),  # inf eigenvalue
+    ('{"type":"frame","seq":0,"t":0}\n{"type":"frame","seq":5,"t":1}\n'
+     '{"type":"frame","seq":3,"t":2}', "frame seq 3 does not increase (previous 5)"),        # no-odom frame
+])
+def test_review_findings_are_obslog_errors(tmp_path, line, msg):
+    p = tmp_path / "bad.jsonl"
+    p.write_text('{"type":"header","format":"cyl-observations","version":1}\n' + line + "\n")
+    with pytest.raises(ObsLogError) as e:
+        read_obslog(str(p))
+    assert msg in str(e.value) and str(e.value).startswith(f"{p}:")
 
 
 def test_missing_file_is_an_obslog_error(tmp_path):

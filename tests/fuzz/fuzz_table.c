@@ -1,7 +1,7 @@
 /* libFuzzer: the colour table loader. Any input must give a status, never a crash; a
  * table that loads must save back to the same bytes.
- * The CRC-32 guards everything after it, so random mutations almost never reach the content
- * checks (class records, padding). Each input is therefore also loaded a second time with its
+ * The loader checks the CRC-32 (the last 4 bytes, over everything before them) before the
+ * content, so random mutations almost never reach the content checks (class records, padding). Each input is therefore also loaded a second time with its
  * CRC recomputed (the first CYL_TABLE_FILE_SIZE bytes, padded with zeros): that copy may only
  * fail as corrupt, never on the checksum, and must round-trip when it loads. */
 #include <stdint.h>

@@ -102,6 +102,18 @@ TEST(SynthRender, SourceDriveEqualsMakeDrive)
     EXPECT_NE(d[5].odo.dx_m, d[5].true_dx);
 }
 
+// Golden values: the drive of seed 9 (default scene), printed with %.17g by the first
+// implementation (all steps generated up front, commit 1e4df48). Streaming must not have changed the sequence: `make demo`
+// and the committed fixtures depend on it.
+TEST(SynthRender, DriveGoldenValues)
+{
+    std::vector<DriveStep> d = make_drive(default_scene(), 6, 9);
+    EXPECT_DOUBLE_EQ(d[1].odo.dx_m, 0.019824666187517492);
+    EXPECT_DOUBLE_EQ(d[5].odo.dy_m, -0.00018557369266475137);
+    EXPECT_DOUBLE_EQ(d[5].odo.dtheta_rad, -0.0036995226961980374);
+    EXPECT_DOUBLE_EQ(d[5].truth.x, 0.83973334242962261);
+}
+
 TEST(SynthRender, SourceEventOrderAndInfo)
 {
     Scene s = default_scene();
