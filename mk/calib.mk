@@ -19,7 +19,7 @@ CALIB_CXXFLAGS = $(CXXFLAGS_ALL) -I/usr/include/eigen3 $(CV_FLAGS)
 CALIB_LIBS = $(CALIB_A) $(CALIB_FE_A) $(CALIB_SYNTH_OBJS) $(LIBCYL_A) -lceres -lglog -lgflags $(CV_LIBS) -lpthread -lm
 CALIB_DEPS := $(CALIB_A) $(CALIB_FE_A) $(CALIB_SYNTH_OBJS) lib
 
-$(BUILD)/calib/%.o: frontend/src/calib/%.cpp $(CALIB_HDRS) | $(STAMP)/debs-calib $(STAMP)/debs-cv
+$(BUILD)/calib/%.o: frontend/src/calib/%.cpp $(CALIB_HDRS) $(wildcard frontend/src/calib/*.hpp) | $(STAMP)/debs-calib $(STAMP)/debs-cv
 	@mkdir -p $(dir $@)
 	$(CXX) $(CALIB_CXXFLAGS) -c $< -o $@
 

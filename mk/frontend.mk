@@ -36,7 +36,7 @@ vivid-test: $(STAMP)/debs-vivid $(BUILD)/vivid_test
 # ---- the cyl tool -------------------------------------------------------------------------
 FE_SYNTH_SRCS := $(sort $(wildcard frontend/src/synth/*.cpp))
 FE_SYNTH_OBJS := $(FE_SYNTH_SRCS:frontend/src/synth/%.cpp=$(BUILD)/frontend/synth/%.o)
-$(BUILD)/frontend/synth/%.o: frontend/src/synth/%.cpp $(FRONTEND_HDRS) $(wildcard libcyl/include/cyl/*.h) | $(STAMP)/debs-cv
+$(BUILD)/frontend/synth/%.o: frontend/src/synth/%.cpp $(wildcard frontend/src/synth/*.hpp) $(FRONTEND_HDRS) $(wildcard libcyl/include/cyl/*.h) | $(STAMP)/debs-cv
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) -c $< -o $@
 $(BUILD)/cyl: frontend/tools/cyl.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib

@@ -10,7 +10,7 @@ SYNTH_SRCS := $(sort $(wildcard frontend/src/synth/*.cpp))
 ifeq ($(strip $(FE_SYNTH_OBJS)),)
 # mk/frontend.mk does not compile frontend/src/synth: do it here.
 SYNTH_OBJS := $(SYNTH_SRCS:frontend/src/synth/%.cpp=$(BUILD)/synth/%.o)
-$(BUILD)/synth/%.o: frontend/src/synth/%.cpp $(wildcard frontend/include/cylfe/*.hpp) \
+$(BUILD)/synth/%.o: frontend/src/synth/%.cpp $(wildcard frontend/src/synth/*.hpp) $(wildcard frontend/include/cylfe/*.hpp) \
 		$(wildcard libcyl/include/cyl/*.h) | $(STAMP)/debs-cv
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS_ALL) $$(pkg-config --cflags opencv4) -c $< -o $@

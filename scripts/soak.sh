@@ -3,7 +3,7 @@
 # `cyl detect` process). The process's peak resident memory (VmHWM) is read when its log reaches
 # frame 1,000 and again at the end: the peak of the 10,000-frame run
 # must equal the peak of its first 1,000 frames, i.e. nothing grows per frame. Measured in one
-# process, because two separate runs of the same command differ by up to ~1 MB from start-up alone.
+# process, because two separate runs of the same command differ by ~1.2 MB from start-up alone.
 # Checkpoints at 2,000 and 5,000 frames are printed too.
 set -euo pipefail
 B=${BUILD:-build}

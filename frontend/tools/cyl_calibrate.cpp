@@ -359,10 +359,7 @@ int main(int argc, char **argv)
     }
     try {
         return a.cmd == "intrinsics" ? run_intrinsics(a, join_args(argc, argv, a)) : run_mount(a, join_args(argc, argv, a));
-    } catch (const Error &e) {
-        std::fprintf(stderr, "cyl-calibrate: error: %s\n", e.what());
-        return kExitFailure;
-    } catch (const std::exception &e) {
+    } catch (const std::exception &e) {  // cylfe::Error included
         std::fprintf(stderr, "cyl-calibrate: error: %s\n", e.what());
         return kExitFailure;
     }

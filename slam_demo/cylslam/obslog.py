@@ -84,11 +84,12 @@ def _str(rec, key, where):
     return v
 
 
-def _numlist(rec, key, n, where):
+def _numlist(rec, key, n, where, layout=""):
+    """rec[key] as n floats; `layout` (e.g. " (xx xy ...)") ends the error message."""
     v = rec.get(key)
     if (not isinstance(v, list) or len(v) != n or
             not all(isinstance(x, (int, float)) and not isinstance(x, bool) and _finite(x) for x in v)):
-        raise ObsLogError(f"{where}: field {key!r} must be a list of {n} finite numbers")
+        raise ObsLogError(f"{where}: field {key!r} must be a list of {n} finite numbers{layout}")
     return [float(x) for x in v]
 
 
@@ -191,13 +192,7 @@ class _Builder:
                                  flags=flags, lm_id=lm_id, where=where, jac_calib=jm, cov_frame=cf))
         elif typ == "odom":
             d = np.array([_num(rec, k, where) for k in ("dx_m", "dy_m", "dtheta_rad")])
-            c = rec.get("cov")
-            if (not isinstance(c, list) or len(c) != 6 or
-                    not all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                            and _finite(v) for v in c)):
-                raise ObsLogError(f"{where}: field 'cov' must be a list of 6 finite numbers "
-                                  "(xx xy xt yy yt tt)")
-            xx, xy, xt, yy, yt, tt = c
+            xx, xy, xt, yy, yt, tt = _numlist(rec, "cov", 6, where, " (xx xy xt yy yt tt)")
             cov = np.array([[xx, xy, xt], [xy, yy, yt], [xt, yt, tt]], float)
             _check_cov(cov, where, "odometry")
             fr = self._frame_of(rec, where, "odom")

@@ -1,5 +1,6 @@
 // cylfe::calib -- chessboard detection and the intrinsic calibration (calib.hpp).
 #include "cylfe/calib.hpp"
+#include "solver.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -218,14 +219,7 @@ IntrinsicResult calibrate_intrinsics(const std::vector<std::vector<cv::Point3f>>
     const int p = n_free_intr + 6 * (int)nv;
     if (2 * npts <= p) throw Error("intrinsic calibration: too few corners for the parameters");
 
-    ceres::Solver::Options so;
-    so.linear_solver_type = ceres::DENSE_SCHUR;
-    so.max_num_iterations = opt.max_iterations;
-    so.function_tolerance = 1e-15;
-    so.gradient_tolerance = 1e-14;
-    so.parameter_tolerance = 1e-14;
-    so.num_threads = 1;
-    so.logging_type = ceres::SILENT;
+    const ceres::Solver::Options so = calib_detail::tight_solver_options(ceres::DENSE_SCHUR, opt.max_iterations);
     ceres::Solver::Summary sum;
     ceres::Solve(so, &problem, &sum);
     if (!sum.IsSolutionUsable() || !std::isfinite(sum.final_cost))

@@ -1,5 +1,6 @@
 // cylfe::calib -- the robot mount's extrinsics from a chessboard lying on the floor (calib.hpp).
 #include "cylfe/calib.hpp"
+#include "solver.hpp"
 
 #include <array>
 #include <cmath>
@@ -113,13 +114,7 @@ MountEstimate estimate_mount(const cyl_camera &cam, const Board &b, const BoardP
             problem.AddResidualBlock(new ceres::NumericDiffCostFunction<PoseReproj, ceres::CENTRAL, 2, 6>(
                                          new PoseReproj{&cam, obj[i].x, obj[i].y, corners[i].x, corners[i].y, w}),
                                      nullptr, pose);
-        ceres::Solver::Options so;
-        so.linear_solver_type = ceres::DENSE_QR;
-        so.function_tolerance = 1e-15;
-        so.gradient_tolerance = 1e-14;
-        so.parameter_tolerance = 1e-14;
-        so.max_num_iterations = 100;
-        so.logging_type = ceres::SILENT;
+        const ceres::Solver::Options so = calib_detail::tight_solver_options(ceres::DENSE_QR, 100);
         ceres::Solver::Summary sum;
         ceres::Solve(so, &problem, &sum);
         if (!sum.IsSolutionUsable()) throw Error(name + ": board pose fit failed: " + sum.message);

@@ -1,6 +1,7 @@
 // The paper's consistency experiments on rendered frames (docs/synthetic.md).
 #include "cylfe/synth_experiments.hpp"
 #include "cylfe/error.hpp"
+#include "corners.hpp"
 #include "random.hpp"
 
 #include <algorithm>
@@ -62,22 +63,14 @@ std::vector<std::array<double, 3>> cylinder_points(const Cylinder &c)
 std::vector<std::array<double, 3>> box_points(const Box &b)
 {
     std::vector<std::array<double, 3>> pts;
-    double ca = std::cos(b.yaw_rad), sa = std::sin(b.yaw_rad);
-    for (int k = 0; k < 8; k++) {
-        double lx = (k & 1 ? 0.5 : -0.5) * b.size_x_m, ly = (k & 2 ? 0.5 : -0.5) * b.size_y_m;
-        pts.push_back({b.x_m + ca * lx - sa * ly, b.y_m + sa * lx + ca * ly, k & 4 ? b.size_z_m : 0.0});
-    }
+    detail::append_rect_corners(b.x_m, b.y_m, b.yaw_rad, b.size_x_m, b.size_y_m, {0.0, b.size_z_m}, pts);
     return pts;
 }
 
 std::vector<std::array<double, 3>> patch_points(const FloorPatch &p)
 {
     std::vector<std::array<double, 3>> pts;
-    double ca = std::cos(p.yaw_rad), sa = std::sin(p.yaw_rad);
-    for (int k = 0; k < 4; k++) {
-        double lx = (k & 1 ? 0.5 : -0.5) * p.size_x_m, ly = (k & 2 ? 0.5 : -0.5) * p.size_y_m;
-        pts.push_back({p.x_m + ca * lx - sa * ly, p.y_m + sa * lx + ca * ly, 0.0});
-    }
+    detail::append_rect_corners(p.x_m, p.y_m, p.yaw_rad, p.size_x_m, p.size_y_m, {0.0}, pts);
     return pts;
 }
 

@@ -2,6 +2,7 @@
 // nothing here calls libcyl's camera model.
 #include "cylfe/synth.hpp"
 #include "cylfe/error.hpp"
+#include "corners.hpp"
 #include "random.hpp"
 
 #include <algorithm>
@@ -328,12 +329,7 @@ void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out) co
     for (size_t i = 0; i < s.boxes.size(); i++) {
         const Box &bx = s.boxes[i];
         pts.clear();
-        double ca = std::cos(bx.yaw_rad), sa = std::sin(bx.yaw_rad);
-        for (int k = 0; k < 8; k++) {
-            double lx = (k & 1 ? 0.5 : -0.5) * bx.size_x_m, ly = (k & 2 ? 0.5 : -0.5) * bx.size_y_m;
-            double z = k & 4 ? bx.size_z_m : 0.0;
-            pts.push_back({bx.x_m + ca * lx - sa * ly, bx.y_m + sa * lx + ca * ly, z});
-        }
+        detail::append_rect_corners(bx.x_m, bx.y_m, bx.yaw_rad, bx.size_x_m, bx.size_y_m, {0.0, bx.size_z_m}, pts);
         SBox b = screen_box(cam, cp, pts);
         if (b.x0 <= b.x1 && b.y0 <= b.y1) objs.push_back({1, i, b});
     }
