@@ -16,7 +16,7 @@ $(FRONTEND_A): $(FRONTEND_OBJS)
 
 # ---- V4L2 against the kernel's vivid driver, under qemu (part of make test) --------------
 DEBS_VIVID := qemu-system-x86 busybox-static cpio kmod xz-utils binutils
-VIVID_SRCS := tests/v4l2/vivid_test.cpp frontend/src/v4l2.cpp frontend/src/rawlog.cpp
+VIVID_SRCS := tests/v4l2/vivid_test.cpp frontend/src/v4l2.cpp frontend/src/rawlog.cpp frontend/src/output_file.cpp
 # Static, so the VM needs nothing else; under SAN=1 dynamic (the sanitizer runtimes are shared
 # libraries) and scripts/vivid-test.sh copies its libraries into the VM.
 ifeq ($(SAN),1)
@@ -58,8 +58,11 @@ $(BUILD)/bench_replay: bench/bench_replay.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
 	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) -O2 $< -o $@ $(FRONTEND_A) $(FE_SYNTH_OBJS) $(LIBCYL_A) $(CV_LIBS) -lm
 
 # ---- the cyl tool as a user meets it (exit codes, bad input, SIGINT) --------------------------
-TEST_EXTRA += $(BUILD)/cyl
+TEST_EXTRA += $(BUILD)/cyl $(BUILD)/cyl-render
 TEST_EXTRA_BINS += tests/frontend/test_cli.sh:$(BUILD)/cyl
+# every writer of every tool against a device node, a FIFO and symlinks (only regular files are replaced)
+TEST_EXTRA += $(BUILD)/cyl-train $(BUILD)/cyl-calibrate
+TEST_EXTRA_BINS += tests/frontend/test_output_safety.sh:$(BUILD)
 
 # ---- make soak: 10,000 synthetic frames in one process; peak RSS at the end must equal its
 # peak at frame 1,000 (issue 8; scripts/soak.sh) ----------------------------------------------

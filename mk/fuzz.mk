@@ -15,10 +15,10 @@ $(FUZZ_LIB): $(wildcard libcyl/src/*.c libcyl/src/*.h libcyl/include/cyl/*.h) $(
 $(FUZZ_DIR)/%: tests/fuzz/%.c $(FUZZ_LIB)
 	@mkdir -p $(dir $@)
 	clang -std=c99 $(FUZZ_FLAGS) -Ilibcyl/include $< -o $@ $(FUZZ_LIB) -lm
-$(FUZZ_DIR)/%: tests/fuzz/%.cpp $(FUZZ_LIB) frontend/src/rawlog.cpp frontend/src/calibration.cpp $(STAMP)/debs-cv
+$(FUZZ_DIR)/%: tests/fuzz/%.cpp $(FUZZ_LIB) frontend/src/rawlog.cpp frontend/src/output_file.cpp frontend/src/calibration.cpp $(STAMP)/debs-cv
 	@mkdir -p $(dir $@)
 	clang++ -std=c++17 $(FUZZ_FLAGS) -Ilibcyl/include -Ifrontend/include $(CV_FLAGS) $< \
-	  frontend/src/rawlog.cpp frontend/src/calibration.cpp -o $@ $(FUZZ_LIB) $(CV_LIBS) -lm
+	  frontend/src/rawlog.cpp frontend/src/output_file.cpp frontend/src/calibration.cpp -o $@ $(FUZZ_LIB) $(CV_LIBS) -lm
 
 # The observation-log reader is Python (slam_demo/cylslam/obslog.py): its target runs under atheris,
 # libFuzzer's engine for Python, installed into the project venv.

@@ -15,6 +15,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "cylfe/error.hpp"
+#include "cylfe/output_file.hpp"
 
 extern "C" {
 #include "cyl/image.h"
@@ -235,16 +236,22 @@ CameraCalibration load_camera_calibration(const std::string &path)
 
 void write_file_atomic(const std::string &path, const std::string &text)
 {
-    std::string tmp = path + ".tmp." + std::to_string(getpid());
-    FILE *f = std::fopen(tmp.c_str(), "wb");
+    OutputPlan plan = plan_output(path, ".tmp." + std::to_string(getpid()));
+    FILE *f = std::fopen(plan.write_to.c_str(), "wb");
     if (!f) throw Error(path + ": cannot write: " + std::strerror(errno));
     bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
     ok = (std::fflush(f) == 0) && ok;
     ok = (std::fclose(f) == 0) && ok;
-    if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    if (!ok) {
         int e = errno;
-        std::remove(tmp.c_str());
+        if (plan.staged) std::remove(plan.write_to.c_str());
         throw Error(path + ": cannot write: " + std::strerror(e));
+    }
+    try {
+        finish_output(plan);
+    } catch (...) {
+        std::remove(plan.write_to.c_str());
+        throw;
     }
 }
 

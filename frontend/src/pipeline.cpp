@@ -121,7 +121,8 @@ ObservationLog::ObservationLog(const std::string &path, const Header &h) : path_
         f_ = stdout;
         is_stdout_ = true;
     } else {
-        part_ = path + ".part";
+        plan_ = plan_output(path);
+        part_ = plan_.write_to;
         f_ = std::fopen(part_.c_str(), "w");
         if (!f_) throw Error(part_ + ": cannot create: " + std::strerror(errno));
     }
@@ -242,8 +243,7 @@ void ObservationLog::close()
     bad |= std::fclose(f_) != 0;
     f_ = nullptr;
     if (bad) throw Error(part_ + ": write failed: " + std::strerror(errno));
-    if (std::rename(part_.c_str(), path_.c_str()) != 0)
-        throw Error(part_ + ": cannot rename to " + path_ + ": " + std::strerror(errno));
+    finish_output(plan_);
 }
 
 } // namespace cylfe

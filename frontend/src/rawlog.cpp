@@ -56,8 +56,9 @@ std::string fourcc_str(uint32_t fcc)
 // ---- writer -------------------------------------------------------------------------
 
 RawLogWriter::RawLogWriter(const std::string &path, const StreamInfo &info)
-    : path_(path), part_(path + ".part"), info_(info)
+    : path_(path), plan_(plan_output(path)), info_(info)
 {
+    part_ = plan_.write_to;
     if (pixfmt_from_fourcc(info.fourcc) == 0)
         throw Error(path + ": unsupported pixel format " + fourcc_str(info.fourcc));
     f_ = std::fopen(part_.c_str(), "wb");
@@ -141,8 +142,7 @@ void RawLogWriter::close()
     bad |= std::fclose(f_) != 0;
     f_ = nullptr;
     if (bad) throw Error(part_ + ": write failed: " + errno_text());
-    if (std::rename(part_.c_str(), path_.c_str()) != 0)
-        throw Error(part_ + ": cannot rename to " + path_ + ": " + errno_text());
+    finish_output(plan_);
 }
 
 // ---- reader -------------------------------------------------------------------------

@@ -21,6 +21,7 @@
 #include "cylfe/error.hpp"
 #include "cylfe/overlay.hpp"
 #include "cylfe/pipeline.hpp"
+#include "cylfe/progress.hpp"
 #include "cylfe/rawlog.hpp"
 #include "cylfe/sources.hpp"
 #include "cylfe/synth.hpp"
@@ -62,8 +63,9 @@ const char *kUsage =
     "  --table FILE         colour table (libcyl CYLT file); synthetic default calib_data/synthetic.cylt\n"
     "  --calib FILE         camera calibration (OpenCV or ROS YAML, with libcyl's mount and sigma\n"
     "                       fields); for the synthetic source the default is the scene's own camera\n"
-    "  --out FILE|-         observation log (default -, stdout); a file is written as FILE.part and\n"
-    "                       renamed when the run ends\n"
+    "  --out FILE|-         observation log (default -, stdout); a regular file is written as\n"
+    "                       FILE.part and renamed when the run ends; a device node or FIFO is\n"
+    "                       written in place, a symlink through to its file, a dangling one refused\n"
     "  --model exact|paper  geometric model (default exact)\n"
     "  --estimator local|column|uniform   centroid variance estimator (default local)\n"
     "  --size CLASS=D,H     physical landmark size of a class in m (diameter, height), repeatable;\n"
@@ -193,33 +195,6 @@ cyl_colortable load_table(const std::string &path)
     return t;
 }
 
-// Progress on stderr: a bar on a terminal, a line per 10% otherwise.
-class Progress {
-public:
-    explicit Progress(bool enabled) : on_(enabled), tty_(isatty(2)) {}
-    void update(double frac, uint64_t frames, double fps)
-    {
-        if (!on_ || frac < 0) return;
-        int pct = (int)std::lround(frac * 100.0);
-        if (tty_) {
-            int n = pct / 4;
-            std::fprintf(stderr, "\r[%-25s] %3d%% %llu frames %.0f fps", std::string((size_t)n, '#').c_str(), pct,
-                         (unsigned long long)frames, fps);
-        } else if (pct / 10 > last_ / 10) {
-            std::fprintf(stderr, "progress: %d%% (%llu frames, %.0f fps)\n", pct, (unsigned long long)frames, fps);
-        }
-        last_ = pct;
-    }
-    void done()
-    {
-        if (on_ && tty_) std::fputc('\n', stderr);
-    }
-
-private:
-    bool on_, tty_;
-    int last_ = -1;
-};
-
 double now_s()
 {
     timespec ts;
@@ -311,7 +286,7 @@ int cmd_detect(const Args &a)
             overlay_dir = true;
         }
     }
-    Progress progress(!a.quiet && a.out != "-");
+    Progress progress(!a.quiet && a.out != "-", "detecting", "frames");
     SourceEvent ev;
     uint64_t frames = 0, observations = 0, truncated = 0;
     double t0 = now_s();
@@ -370,7 +345,7 @@ int cmd_record(const Args &a)
     apply_v4l2_options(*src, a, a.quiet);
     StreamInfo info = src->info();
     RawLogWriter w(a.out, info);
-    Progress progress(!a.quiet);
+    Progress progress(!a.quiet, "recording", "frames");
     SourceEvent ev;
     uint64_t frames = 0;
     double t0 = now_s();

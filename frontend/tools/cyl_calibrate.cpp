@@ -70,7 +70,8 @@ const char *kUsage =
     "\n"
     "exit codes: 0 ok, 1 failed (unreadable image, too few boards, degenerate views, bad\n"
     "calibration file), 2 bad command line. Outputs are written to a temporary file and renamed:\n"
-    "a failed run leaves no partial file.\n";
+    "a failed run leaves no partial file. Only a regular file is replaced: a device node or FIFO is\n"
+    "written in place, a symbolic link through to its file; a dangling link is refused.\n";
 
 struct Usage : std::runtime_error {
     using std::runtime_error::runtime_error;

@@ -1,6 +1,7 @@
 // cyl-render: render a synthetic drive (frames, odometry, ground truth) into a raw frame log
 // (*.cylraw, docs/formats.md); also writes scene files, the scene's colour table and camera.
 #include "cylfe/error.hpp"
+#include "cylfe/progress.hpp"
 #include "cylfe/rawlog.hpp"
 #include "cylfe/synth.hpp"
 #include "cylfe/synth_experiments.hpp"
@@ -46,6 +47,9 @@ void usage(FILE *f)
         "  -q, --quiet             no progress bar\n"
         "  -h, --help              this help\n"
         "\n"
+        "Outputs: a regular file (or a new path) is written as PATH.part and renamed at the end; a\n"
+        "device node or FIFO is written in place, a symbolic link through to its file; a dangling\n"
+        "link is refused.\n"
         "Exit codes: 0 ok, 1 failure, 2 bad command line, 130 interrupted (the complete records\n"
         "written so far stay in PATH.part).\n");
 }
@@ -62,12 +66,13 @@ bool parse_u64(const char *s, uint64_t &v)
 
 void write_file(const std::string &path, const uint8_t *data, size_t n)
 {
-    std::string part = path + ".part";
-    FILE *f = std::fopen(part.c_str(), "wb");
+    cylfe::OutputPlan plan = cylfe::plan_output(path);
+    FILE *f = std::fopen(plan.write_to.c_str(), "wb");
     if (!f) throw Error(path + ": cannot open for writing: " + std::strerror(errno));
     bool ok = std::fwrite(data, 1, n, f) == n;
     ok = (std::fclose(f) == 0) && ok;
-    if (!ok || std::rename(part.c_str(), path.c_str()) != 0) throw Error(path + ": write failed");
+    if (!ok) throw Error(path + ": write failed");
+    cylfe::finish_output(plan);
 }
 
 } // namespace
@@ -165,7 +170,7 @@ int main(int argc, char **argv)
         SourceEvent ev;
         auto t0 = std::chrono::steady_clock::now();
         uint64_t nframes = 0;
-        int last_pct = -1;
+        cylfe::Progress progress(!quiet, "rendering", "frames");
         while (!g_stop && src.next(ev)) {
             switch (ev.kind) {
             case RecordType::Frame: w.frame(ev.header.seq, ev.header.t_ns, ev.data, ev.header.size); nframes++; break;
@@ -173,25 +178,23 @@ int main(int argc, char **argv)
             case RecordType::TruthPose: w.truth_pose(ev.header.seq, ev.header.t_ns, ev.truth_pose); break;
             case RecordType::TruthLandmark: w.truth_landmark(ev.header.t_ns, ev.truth_landmark); break;
             }
-            int pct = (int)(src.progress() * 100);
-            if (!quiet && pct != last_pct) {
-                last_pct = pct;
+            if (ev.kind == RecordType::Frame) {
                 double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-                int bar = pct * 40 / 100;
-                std::fprintf(stderr, "\rrendering [%.*s%*s] %3d%% %llu/%llu frames %.1f s", bar,
-                             "########################################", 40 - bar, "", pct,
-                             (unsigned long long)nframes, (unsigned long long)frames, el);
+                progress.update(src.progress(), nframes, nframes / (el + 1e-9));
             }
         }
+        if (!g_stop) {
+            double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            progress.update(1.0, nframes, nframes / (el + 1e-9));
+        }
+        progress.done();
         if (g_stop) {
-            if (!quiet) std::fprintf(stderr, "\n");
-            std::fprintf(stderr, "cyl-render: interrupted after %llu frames; complete records are in %s.part\n",
-                         (unsigned long long)nframes, out.c_str());
+            std::fprintf(stderr, "cyl-render: interrupted after %llu frames; complete records are in %s\n",
+                         (unsigned long long)nframes, w.written_to().c_str());
             return kExitInterrupted;
         }
         w.close();
         double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        if (!quiet) std::fprintf(stderr, "\n");
         std::fprintf(stderr, "cyl-render: wrote %s: %llu frames %ux%u YUYV, %llu records, %.1f s (%.1f ms/frame)\n",
                      out.c_str(), (unsigned long long)nframes, src.info().width, src.info().height,
                      (unsigned long long)w.records(), el, 1000 * el / std::max<uint64_t>(1, nframes));

@@ -130,6 +130,16 @@ kill -KILL $pid; wait $pid 2>/dev/null
 valid_jsonl "$T/kill.jsonl.part" >/dev/null || fail "the .part file has a broken line"
 finish
 
+# progress on a non-terminal: plain lines, no carriage returns (a log file stays readable)
+start progress_without_terminal
+B=$(dirname "$CYL")
+"$B/cyl-render" -n 12 -o "$T/p.cylraw" 2>"$T/p.err" || fail "cyl-render failed: $(head -c 300 "$T/p.err")"
+"$CYL" detect "$T/p.cylraw" --table $TABLE --calib $CALIB --out "$T/p.jsonl" 2>>"$T/p.err" || fail "detect failed"
+! grep -q $'\r' "$T/p.err" || fail "carriage returns written to a non-terminal"
+grep -q "^rendering: 100%" "$T/p.err" || fail "no progress line from cyl-render: $(head -c 300 "$T/p.err")"
+grep -q "^detecting: 100%" "$T/p.err" || fail "no progress line from cyl detect: $(head -c 300 "$T/p.err")"
+finish
+
 echo "[==========] $((passed + failed)) tests ran."
 echo "[  PASSED  ] $passed tests."
 [ $failed -eq 0 ] || echo "[  FAILED  ] $failed tests."

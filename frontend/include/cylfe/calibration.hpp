@@ -49,7 +49,9 @@ CameraCalibration load_camera_calibration(const std::string &path);
 void save_camera_calibration(const std::string &path, const cyl_camera &cam, bool with_mount = true,
                              const std::string &comment = "");
 
-// Write text to path through "<path>.tmp.<pid>" and rename; throws Error naming the file.
+// Write text to path through "<path>.tmp.<pid>" and rename -- over a regular file only: a device
+// node or FIFO is written directly, a symlink through (cylfe/output_file.hpp). Throws Error naming
+// the file.
 void write_file_atomic(const std::string &path, const std::string &text);
 
 } // namespace cylfe

@@ -47,8 +47,9 @@ private:
 };
 
 // JSON Lines observation log. path "-" writes to stdout; otherwise it writes "<path>.part"
-// and renames it on close(). Every event is flushed, so an interrupted run keeps every
-// complete line.
+// and renames it on close() -- over a regular file only: a device node or FIFO is written
+// directly, a symlink is written through (cylfe/output_file.hpp). Every event is flushed, so
+// an interrupted run keeps every complete line.
 class ObservationLog {
 public:
     struct Header {
@@ -70,7 +71,8 @@ public:
 
 private:
     void write(const std::string &line);
-    std::string path_, part_;
+    std::string path_, part_;  // part_: where the bytes go (plan_.write_to)
+    OutputPlan plan_;
     FILE *f_ = nullptr;
     bool is_stdout_ = false;
     const cyl_colortable *table_ = nullptr;

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "cylfe/output_file.hpp"
+
 extern "C" {
 #include "cyl/image.h"
 }
@@ -59,7 +61,8 @@ struct TruthLandmark {
 
 // Writes to "<path>.part", flushing every record, and renames it to <path> on close(): a good
 // file is never replaced by a partial one, and a killed recording leaves its complete records
-// in the .part file.
+// in the .part file. A device node or FIFO is written directly and a symlink is written through
+// (cylfe/output_file.hpp): only a regular file is ever replaced.
 class RawLogWriter {
 public:
     RawLogWriter(const std::string &path, const StreamInfo &info);
@@ -73,10 +76,13 @@ public:
     void truth_landmark(int64_t t_ns, const TruthLandmark &l);
     void close();                 // flush, rename; throws on I/O error
     uint64_t records() const { return records_; }
+    const std::string &written_to() const { return part_; }  // the .part file, or the path itself
 
 private:
     void record(RecordType type, uint64_t seq, int64_t t_ns, const void *payload, uint32_t n, uint32_t flags);
-    std::string path_, part_;
+    std::string path_;
+    OutputPlan plan_;
+    std::string part_;  // where the bytes go (plan_.write_to)
     FILE *f_ = nullptr;
     StreamInfo info_;
     uint64_t records_ = 0;
