@@ -17,6 +17,7 @@ const char *estimator_name(cyl_noise_estimator e)
     case CYL_NOISE_UNIFORM: return "uniform";
     case CYL_NOISE_COLUMN: return "column";
     case CYL_NOISE_LOCAL: return "local";
+    case CYL_NOISE_IMAGE: return "image";
     }
     return "?";
 }
@@ -33,6 +34,7 @@ bool parse_estimator(const std::string &s, cyl_noise_estimator *e)
     if (s == "uniform") { *e = CYL_NOISE_UNIFORM; return true; }
     if (s == "column") { *e = CYL_NOISE_COLUMN; return true; }
     if (s == "local") { *e = CYL_NOISE_LOCAL; return true; }
+    if (s == "image") { *e = CYL_NOISE_IMAGE; return true; }
     return false;
 }
 
@@ -55,12 +57,19 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
     cyl_status s = cyl_segment(&table_, &img, &config_.segment, &seg_);
     check(s, "segmentation");
     truncated_ = s == CYL_TRUNCATED;
+    // The image estimator reads the frame and the table; it must drop runs and merge as the
+    // segmentation did.
+    config_.observe.image = &img;
+    config_.observe.table = &table_;
+    config_.observe.image_noise.min_run_px = config_.segment.min_run_px;
+    config_.observe.image_noise.merge_gap_px = config_.segment.cls[0].merge_gap_px;
     size_t need = cyl_observe_work_size(&seg_, &config_.observe);
     if (obs_work_.size() < need) obs_work_.resize(need);  // grows to the largest frame seen, once
     obs_.resize(config_.max_observations);
     uint32_t n = 0;
     s = cyl_observe(&seg_, &camera_, &config_.observe, obs_work_.data(), obs_work_.size(), obs_.data(),
                     (uint32_t)obs_.size(), &n);
+    config_.observe.image = nullptr;   // the frame is the caller's, valid during this call only
     check(s, "observation");
     truncated_ = truncated_ || s == CYL_TRUNCATED;
     obs_.resize(n);

@@ -67,7 +67,9 @@ const char *kUsage =
     "                       FILE.part and renamed when the run ends; a device node or FIFO is\n"
     "                       written in place, a symlink through to its file, a dangling one refused\n"
     "  --model exact|paper  geometric model (default exact)\n"
-    "  --estimator local|column|uniform   centroid variance estimator (default local)\n"
+    "  --estimator image|local|column|uniform   centroid variance estimator (default image: from the\n"
+    "                       frame's own noise and the table's boundary; local/column/uniform: the\n"
+    "                       paper's eqs. 6/5/4, from the blob's shape only)\n"
     "  --size CLASS=D,H     physical landmark size of a class in m (diameter, height), repeatable;\n"
     "                       needed for confidence (synthetic default: the scene's)\n"
     "  --centroid-var-floor PX2   lower bound on each centroid variance, px^2 (default 0): a\n"
@@ -87,7 +89,7 @@ const char *kUsage =
     "            2 bad command line, 130 interrupted (outputs closed cleanly)\n";
 
 struct Args {
-    std::string cmd, source, table, calib, out = "-", overlay, model = "exact", estimator = "local";
+    std::string cmd, source, table, calib, out = "-", overlay, model = "exact", estimator = "image";
     std::vector<std::string> sizes, controls;
     double var_floor_px2 = 0.0;
     uint64_t max_frames = 0;
@@ -226,7 +228,7 @@ int cmd_detect(const Args &a)
     cyl_geom_model model;
     cyl_noise_estimator est;
     if (!parse_model(a.model, &model)) usage_error("--model: exact or paper, got '" + a.model + "'");
-    if (!parse_estimator(a.estimator, &est)) usage_error("--estimator: local, column or uniform, got '" + a.estimator + "'");
+    if (!parse_estimator(a.estimator, &est)) usage_error("--estimator: image, local, column or uniform, got '" + a.estimator + "'");
     bool synthetic = is_synthetic(a.source);
     std::string table_path = a.table.empty() && synthetic ? "calib_data/synthetic.cylt" : a.table;
     if (table_path.empty()) usage_error("detect: --table is required");

@@ -33,7 +33,12 @@ void usage(FILE *f)
         "  --frames N       frames per row of Tables 1-3 (default 400)\n"
         "  --runs N         calibration-error runs for Tables 6-7 (default 500, 3 landmarks each)\n"
         "  --conf-frames N  drive frames for the confidence check (default 600, every 3rd used)\n"
-        "  --sweep          also sweep the sensor noise for Tables 1-3 (how the ratio depends on it)\n"
+        "  --sweep          also sweep the imaging for Tables 1-3: sensor noise x0.25 .. x4 and blur\n"
+        "                   0 .. 2 px, a colour table trained for each condition; prints every\n"
+        "                   estimator's ratio to the measured variance (how it depends on them)\n"
+        "  --sweep-only     the sweep alone (implies --sweep; nothing else is run)\n"
+        "  --seed N         seed of the noise in Tables 1-3 and the sweep, and of the table training\n"
+        "                   (default 1; seeds 1-20 chose the estimators' settings, 101-120 are held out)\n"
         "  --quick          reduced sizes (frames 120, runs 150, conf-frames 300)\n"
         "  -h, --help\n");
 }
@@ -50,36 +55,43 @@ void print_variance_tables(const std::vector<VarianceRow> &rows, std::string *cs
     const char *ph[4] = {"0.0323 0.0022 0.0010 0.0015", "0.00051 0.0022 0.00092 0.0016",
                          "0.00089 0.0021 0.0017 0.0011", "0.00031 0.0017 0.0008 0.0015"};
     std::printf("\nTable 1: variance (px^2) of the VERTICAL centroid, 400 frames per row (paper: Actual Uniform Column Local)\n");
-    std::printf("%-6s %-8s %6s | %9s %9s %9s %9s | %6s | paper\n", "Trial", "range", "area", "Actual", "Uniform", "Column", "Local", "L/A");
+    std::printf("%-6s %-8s %6s | %9s %9s %9s %9s %9s | %6s %6s | paper\n", "Trial", "range", "area", "Actual", "Uniform", "Column",
+                "Local", "Image", "L/A", "I/A");
     int i = 0;
     for (const VarianceRow &r : rows) {
         if (r.label.rfind("occluded", 0) == 0) continue;
-        std::printf("%-6d %-8s %6.0f | %9.5f %9.5f %9.5f %9.5f | %6.2f | %s\n", i + 1, r.label.c_str(), r.mean_area,
-                    r.actual_y, r.est_y[0], r.est_y[1], r.est_y[2], r.est_y[2] / r.actual_y, i < 4 ? pv[i] : "");
+        std::printf("%-6d %-8s %6.0f | %9.5f %9.5f %9.5f %9.5f %9.5f | %6.2f %6.2f | %s\n", i + 1, r.label.c_str(), r.mean_area,
+                    r.actual_y, r.est_y[0], r.est_y[1], r.est_y[2], r.est_y[3], r.est_y[2] / r.actual_y,
+                    r.est_y[3] / r.actual_y, i < 4 ? pv[i] : "");
         i++;
     }
     std::printf("\nTable 2: variance (px^2) of the VERTICAL centroid, partially occluded landmark\n");
-    std::printf("%-15s %6s | %9s %9s %9s %9s | %6s | paper\n", "", "area", "Actual", "Uniform", "Column", "Local", "L/A");
+    std::printf("%-15s %6s | %9s %9s %9s %9s %9s | %6s %6s | paper\n", "", "area", "Actual", "Uniform", "Column", "Local",
+                "Image", "L/A", "I/A");
     for (const VarianceRow &r : rows) {
         if (r.label.rfind("occluded", 0) != 0) continue;
-        std::printf("%-15s %6.0f | %9.5f %9.5f %9.5f %9.5f | %6.2f | 0.0267 0.1103 0.0877 0.0198\n", r.label.c_str(),
-                    r.mean_area, r.actual_y, r.est_y[0], r.est_y[1], r.est_y[2], r.est_y[2] / r.actual_y);
+        std::printf("%-15s %6.0f | %9.5f %9.5f %9.5f %9.5f %9.5f | %6.2f %6.2f | 0.0267 0.1103 0.0877 0.0198\n",
+                    r.label.c_str(), r.mean_area, r.actual_y, r.est_y[0], r.est_y[1], r.est_y[2], r.est_y[3],
+                    r.est_y[2] / r.actual_y, r.est_y[3] / r.actual_y);
     }
     std::printf("\nTable 3: variance (px^2 x 1e-4) of the HORIZONTAL centroid (paper's unit)\n");
-    std::printf("%-6s %-15s | %9s %9s %9s %9s | %6s | paper (x1e-4 -> px^2)\n", "Trial", "range", "Actual", "Uniform", "Column", "Local", "L/A");
+    std::printf("%-6s %-15s | %9s %9s %9s %9s %9s | %6s %6s | paper (x1e-4 -> px^2)\n", "Trial", "range", "Actual", "Uniform",
+                "Column", "Local", "Image", "L/A", "I/A");
     i = 0;
     for (const VarianceRow &r : rows) {
-        std::printf("%-6d %-15s | %9.1f %9.1f %9.1f %9.1f | %6.2f | %s\n", i + 1, r.label.c_str(), r.actual_x * 1e4,
-                    r.est_x[0] * 1e4, r.est_x[1] * 1e4, r.est_x[2] * 1e4, r.est_x[2] / r.actual_x, i < 4 ? ph[i] : "");
+        std::printf("%-6d %-15s | %9.1f %9.1f %9.1f %9.1f %9.1f | %6.2f %6.2f | %s\n", i + 1, r.label.c_str(), r.actual_x * 1e4,
+                    r.est_x[0] * 1e4, r.est_x[1] * 1e4, r.est_x[2] * 1e4, r.est_x[3] * 1e4, r.est_x[2] / r.actual_x,
+                    r.est_x[3] / r.actual_x, i < 4 ? ph[i] : "");
         i++;
     }
     if (csv) {
-        *csv = "label,range_m,frames,detected,mean_area,actual_x,uniform_x,column_x,local_x,actual_y,uniform_y,column_y,local_y\n";
+        *csv = "label,range_m,frames,detected,mean_area,actual_x,uniform_x,column_x,local_x,image_x,actual_y,uniform_y,column_y,"
+               "local_y,image_y\n";
         for (const VarianceRow &r : rows) {
             char b[400];
-            snprintf(b, sizeof b, "%s,%.3f,%u,%u,%.1f,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", r.label.c_str(), r.range_m,
-                     r.frames, r.detected, r.mean_area, r.actual_x, r.est_x[0], r.est_x[1], r.est_x[2], r.actual_y,
-                     r.est_y[0], r.est_y[1], r.est_y[2]);
+            snprintf(b, sizeof b, "%s,%.3f,%u,%u,%.1f,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", r.label.c_str(),
+                     r.range_m, r.frames, r.detected, r.mean_area, r.actual_x, r.est_x[0], r.est_x[1], r.est_x[2],
+                     r.est_x[3], r.actual_y, r.est_y[0], r.est_y[1], r.est_y[2], r.est_y[3]);
             *csv += b;
         }
     }
@@ -143,7 +155,8 @@ int main(int argc, char **argv)
 {
     std::string out = "build/validate", scene_name = "default";
     unsigned frames = 400, runs = 500, conf_frames = 600;
-    bool sweep = false;
+    bool sweep = false, sweep_only = false;
+    uint64_t seed = 1;
     for (int i = 1; i < argc; i++) {
         std::string a = argv[i];
         auto num = [&]() -> unsigned {
@@ -160,6 +173,8 @@ int main(int argc, char **argv)
         else if (a == "--runs") runs = num();
         else if (a == "--conf-frames") conf_frames = num();
         else if (a == "--sweep") sweep = true;
+        else if (a == "--sweep-only") sweep = sweep_only = true;
+        else if (a == "--seed") seed = num();
         else if (a == "--quick") { frames = 120; runs = 150; conf_frames = 300; }
         else { std::fprintf(stderr, "cyl-synth-validate: unknown option '%s'\n", a.c_str()); usage(stderr); return kExitUsage; }
     }
@@ -168,7 +183,7 @@ int main(int argc, char **argv)
         Scene scene = scene_by_name(scene_name);
         Timer tt;
         cyl_colortable table;
-        train_colortable(scene, &table, 1);
+        train_colortable(scene, &table, seed);
         std::printf("synthetic camera: %ux%u fx %.1f fy %.1f, tilt %.1f deg, camera %.3f m above the floor, "
                     "h = %.3f m above the landmark centroid, s = %.2f m; landmarks %.2f m x %.2f m\n",
                     scene.camera.width, scene.camera.height, scene.camera.fx, scene.camera.fy,
@@ -182,30 +197,95 @@ int main(int argc, char **argv)
         // ---- Tables 1-3
         VarianceConfig vc;
         vc.frames = frames;
-        std::vector<VarianceRow> rows = run_variance_tables(scene, table, vc);
-        std::string csv;
-        print_variance_tables(rows, &csv);
-        write_text(out + "/tables123.csv", csv);
+        vc.seed = seed;
         double lr_min = 1e30, lr_max = 0;
-        for (const VarianceRow &r : rows) {
-            for (double q : {r.est_x[2] / r.actual_x, r.est_y[2] / r.actual_y}) { lr_min = std::min(lr_min, q); lr_max = std::max(lr_max, q); }
+        if (!sweep_only) {
+            std::vector<VarianceRow> rows = run_variance_tables(scene, table, vc);
+            std::string csv;
+            print_variance_tables(rows, &csv);
+            write_text(out + "/tables123.csv", csv);
+            for (const VarianceRow &r : rows) {
+                for (double q : {r.est_x[2] / r.actual_x, r.est_y[2] / r.actual_y}) { lr_min = std::min(lr_min, q); lr_max = std::max(lr_max, q); }
+            }
+            std::printf("local / actual over all rows and both axes: %.2f .. %.2f (bound: 0.5 .. 2)   [%.0f s]\n", lr_min, lr_max, tt.s());
+            plot_variance(out + "/variance_estimators.png", rows);
         }
-        std::printf("local / actual over all rows and both axes: %.2f .. %.2f (bound: 0.5 .. 2)   [%.0f s]\n", lr_min, lr_max, tt.s());
-        plot_variance(out + "/variance_estimators.png", rows);
         if (sweep) {
-            std::printf("\nSensor-noise sweep (rows averaged: local/actual for x and y, min..max):\n");
-            for (double f : {0.5, 0.75, 1.0, 1.5, 2.0}) {
+            // Each condition: the scene's imaging changed, a colour table trained on it (as a user
+            // trains on their own camera), Tables 1-3 measured; ratios estimator / measured over the
+            // rows and both axes.
+            struct Cond { const char *name; double noise, blur; };
+            const Cond conds[] = {{"noise x0.25", 0.25, -1}, {"noise x0.5", 0.5, -1}, {"noise x1", 1, -1},
+                                  {"noise x2", 2, -1},       {"noise x4", 4, -1},    {"blur 0 px", 1, 0},
+                                  {"blur 0.5 px", 1, 0.5},   {"blur 2 px", 1, 2}};
+            const char *en[kEstimators] = {"uniform", "column", "local", "image"};
+            double wmin[kEstimators], wmax[kEstimators];
+            int broken_all = 0;
+            const double kBrokenPx2 = 1.0;
+            for (int e = 0; e < kEstimators; e++) { wmin[e] = 1e30; wmax[e] = 0; }
+            std::string scsv = "condition,seed,noise_y,noise_c,blur_px,label,actual_x,actual_y";
+            for (int e = 0; e < kEstimators; e++) scsv += std::string(",") + en[e] + "_x," + en[e] + "_y";
+            scsv += "\n";
+            std::printf("\nImaging sweep, seed %llu (estimator / measured variance over the rows and both axes, min..max):\n",
+                        (unsigned long long)seed);
+            std::printf("  %-12s %5s %5s %5s | %-13s %-13s %-13s %-13s\n", "condition", "Y", "UV", "blur", en[0], en[1], en[2], en[3]);
+            for (const Cond &c : conds) {
                 Scene s2 = scene;
-                s2.imaging.noise_y *= f;
-                s2.imaging.noise_c *= f;
+                s2.imaging.noise_y *= c.noise;
+                s2.imaging.noise_c *= c.noise;
+                if (c.blur >= 0) s2.imaging.blur_sigma_px = c.blur;
+                cyl_colortable t2;
+                train_colortable(s2, &t2, seed);
                 VarianceConfig v2 = vc;
-                v2.frames = std::min(frames, 200u);
-                auto rr = run_variance_tables(s2, table, v2);
-                double mn = 1e30, mx = 0;
-                for (auto &r : rr)
-                    for (double q : {r.est_x[2] / r.actual_x, r.est_y[2] / r.actual_y}) { mn = std::min(mn, q); mx = std::max(mx, q); }
-                std::printf("  noise x%.2f (Y %.1f, UV %.1f): local/actual %.2f .. %.2f; actual_y row1 %.5f, local_y %.5f\n", f,
-                            s2.imaging.noise_y, s2.imaging.noise_c, mn, mx, rr[0].actual_y, rr[0].est_y[2]);
+                v2.frames = std::min(frames, 150u);
+                auto rr = run_variance_tables(s2, t2, v2);
+                double mn[kEstimators], mx[kEstimators];
+                int broken = 0;
+                for (int e = 0; e < kEstimators; e++) { mn[e] = 1e30; mx[e] = 0; }
+                for (auto &r : rr) {
+                    char b[160];
+                    snprintf(b, sizeof b, "%s,%llu,%.3f,%.3f,%.3f,%s,%.6g,%.6g", c.name, (unsigned long long)seed,
+                             s2.imaging.noise_y, s2.imaging.noise_c, s2.imaging.blur_sigma_px, r.label.c_str(), r.actual_x,
+                             r.actual_y);
+                    scsv += b;
+                    // A centroid that moves by more than 1 px (std) from frame to frame is not noise
+                    // on one blob: the landmark's blob broke up and the largest part changes (a
+                    // segmentation failure, counted apart; no variance estimator models it).
+                    const bool ok = r.actual_x > 0 && r.actual_y > 0 && r.actual_x <= kBrokenPx2 && r.actual_y <= kBrokenPx2;
+                    broken += !ok;
+                    for (int e = 0; e < kEstimators; e++) {
+                        snprintf(b, sizeof b, ",%.6g,%.6g", r.est_x[e], r.est_y[e]);
+                        scsv += b;
+                        if (!ok) continue;
+                        for (double q : {r.est_x[e] / r.actual_x, r.est_y[e] / r.actual_y}) {
+                            mn[e] = std::min(mn[e], q); mx[e] = std::max(mx[e], q);
+                        }
+                    }
+                    scsv += "\n";
+                }
+                std::printf("  %-12s %5.2f %5.2f %5.2f |", c.name, s2.imaging.noise_y, s2.imaging.noise_c, s2.imaging.blur_sigma_px);
+                for (int e = 0; e < kEstimators; e++) {
+                    std::printf(" %5.2f..%-6.2f", mn[e], mx[e]);
+                    wmin[e] = std::min(wmin[e], mn[e]); wmax[e] = std::max(wmax[e], mx[e]);
+                }
+                if (broken) std::printf("   %d of %zu rows: blob broke up", broken, rr.size());
+                std::printf("   [%.0f s]\n", tt.s());
+                broken_all += broken;
+                std::fflush(stdout);
+            }
+            std::printf("  %-30s |", "all conditions");
+            for (int e = 0; e < kEstimators; e++) std::printf(" %5.2f..%-6.2f", wmin[e], wmax[e]);
+            std::printf("   (%d rows with a broken-up blob left out)\n", broken_all);
+            write_text(out + "/sweep.csv", scsv);
+            char js[600];
+            snprintf(js, sizeof js, "{\"seed\":%llu,\"sweep_local_min\":%.3f,\"sweep_local_max\":%.3f,"
+                     "\"sweep_image_min\":%.3f,\"sweep_image_max\":%.3f,\"sweep_uniform_min\":%.3f,\"sweep_uniform_max\":%.3f,"
+                     "\"sweep_column_min\":%.3f,\"sweep_column_max\":%.3f,\"sweep_rows_broken\":%d}",
+                     (unsigned long long)seed, wmin[2], wmax[2], wmin[3], wmax[3], wmin[0], wmax[0], wmin[1], wmax[1], broken_all);
+            if (sweep_only) {
+                write_text(out + "/sweep.json", std::string(js) + "\n");
+                std::printf("%s\n", js);
+                return 0;
             }
         }
 

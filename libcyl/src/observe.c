@@ -15,6 +15,7 @@ cyl_observe_params cyl_observe_params_default(void)
     p.min_area = 1;
     p.min_var_px2 = 0.0;
     p.nonlinear_rel_sigma = 0.055;
+    p.image_noise = cyl_noise_image_params_default();
     return p;
 }
 
@@ -71,6 +72,7 @@ cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
     if (work_size < cyl_observe_work_size(seg, p)) return CYL_ERR_NOMEM;
     if (p->model != CYL_GEOM_EXACT && p->model != CYL_GEOM_PAPER) return CYL_ERR_ARG;
     if (!(p->min_var_px2 >= 0.0)) return CYL_ERR_ARG;
+    if (p->estimator == CYL_NOISE_IMAGE && (!p->image || !p->table)) return CYL_ERR_ARG;
     for (bi = 0; bi < seg->n_blobs; bi++) {
         const cyl_blob *b = &seg->blobs[bi];
         cyl_observation *o;
@@ -79,7 +81,10 @@ cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
         if (b->cls >= CYL_MAX_CLASSES || !(p->class_mask & (1u << b->cls))) continue;
         if (b->area < p->min_area) continue;
         if (n == cap) { ret = CYL_TRUNCATED; break; }
-        st = cyl_noise_blob(seg, b, p->estimator, work, work_size, &cn);
+        if (p->estimator == CYL_NOISE_IMAGE)
+            st = cyl_noise_blob_image(seg, b, p->image, p->table, &p->image_noise, &cn);
+        else
+            st = cyl_noise_blob(seg, b, p->estimator, work, work_size, &cn);
         if (st == CYL_ERR_EMPTY) continue;
         if (st != CYL_OK) return st;
         o = &out[n++];

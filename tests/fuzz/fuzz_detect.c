@@ -98,7 +98,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     cam.height_m = 0.1 + take(&data, &size, 100) / 100.0;
     cam.tilt_sigma_rad = 0.01; cam.yaw_sigma_rad = 0.01; cam.height_sigma_m = 0.001;
     op.size[0].diameter_m = 0.1; op.size[0].height_m = 0.3;
-    op.estimator = (cyl_noise_estimator)take(&data, &size, 3);
+    op.estimator = (cyl_noise_estimator)take(&data, &size, 4);  /* uniform, column, local, image */
+    op.image = &img;
+    op.table = &t;
+    op.image_noise.band_px = 1 + take(&data, &size, 4);
+    op.image_noise.draws = 2 + take(&data, &size, 8);
+    op.image_noise.min_run_px = p.min_run_px;
+    op.image_noise.merge_gap_px = p.cls[0].merge_gap_px;
     op.model = (cyl_geom_model)take(&data, &size, 2);
     if (cyl_observe_work_size(&seg, &op) > sizeof work) return 0;
     s = cyl_observe(&seg, &cam, &op, work, sizeof work, obs, 64, &n_obs);

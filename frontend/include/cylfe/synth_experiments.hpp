@@ -34,6 +34,7 @@ public:
     // Observations with camera cam (estimator as given).
     const std::vector<cyl_observation> &observe(const cyl_camera &cam, cyl_noise_estimator est);
     const cyl_segmentation &seg() const { return seg_; }
+    const cyl_image &image() const { return img_; }   // the last frame segmented
     cyl_segment_params seg_params;
     cyl_observe_params obs_params;
 
@@ -42,18 +43,21 @@ private:
     uint32_t w_, h_;
     std::vector<uint8_t> mem_, work_;
     cyl_segmentation seg_{};
+    cyl_image img_{};
     std::vector<cyl_observation> obs_;
 };
 
 // ---- Tables 1-3 -----------------------------------------------------------------------------
+constexpr int kEstimators = CYL_NOISE_IMAGE + 1;
 struct VarianceRow {
     std::string label;          // "1.0 m", "occluded 1.6 m", ...
     double range_m = 0;
     uint32_t frames = 0, detected = 0;
     double mean_area = 0;
     double actual_x = 0, actual_y = 0;      // measured variance of the centroid over the frames, px^2
-    double est_x[3] = {0, 0, 0};            // mean estimator output (uniform, column, local), px^2
-    double est_y[3] = {0, 0, 0};
+    // mean estimator output, indexed by cyl_noise_estimator (uniform, column, local, image), px^2
+    double est_x[kEstimators] = {0, 0, 0, 0};
+    double est_y[kEstimators] = {0, 0, 0, 0};
 };
 struct VarianceConfig {
     std::vector<double> ranges_m{1.0, 1.6, 2.4, 3.4};

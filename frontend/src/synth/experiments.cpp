@@ -119,9 +119,12 @@ Detect::Detect(const cyl_colortable &t, const Scene &s)
 
 void Detect::segment(const uint8_t *yuyv)
 {
-    cyl_image img;
-    check(cyl_image_wrap(&img, CYL_FMT_YUYV, w_, h_, yuyv, 0), "frame");
-    check(cyl_segment(t_, &img, &seg_params, &seg_), "cyl_segment");
+    check(cyl_image_wrap(&img_, CYL_FMT_YUYV, w_, h_, yuyv, 0), "frame");
+    check(cyl_segment(t_, &img_, &seg_params, &seg_), "cyl_segment");
+    obs_params.image = &img_;
+    obs_params.table = t_;
+    obs_params.image_noise.min_run_px = seg_params.min_run_px;
+    obs_params.image_noise.merge_gap_px = seg_params.cls[0].merge_gap_px;
 }
 
 const std::vector<cyl_observation> &Detect::observe(const cyl_camera &cam, cyl_noise_estimator est)
@@ -185,7 +188,7 @@ std::vector<VarianceRow> run_variance_tables(const Scene &base, const cyl_colort
         row.range_m = r;
         row.frames = cfg.frames;
         std::vector<double> cx, cy;
-        double sx[3] = {0, 0, 0}, sy[3] = {0, 0, 0}, area = 0;
+        double sx[kEstimators] = {}, sy[kEstimators] = {}, area = 0;
         for (uint32_t k = 0; k < cfg.frames; k++) {
             ren.finish_yuyv(clean, mix_seed(cfg.seed, ci * 100000 + k, 0x7AB1), frame);
             det.segment(frame.data());
@@ -193,14 +196,18 @@ std::vector<VarianceRow> run_variance_tables(const Scene &base, const cyl_colort
             if (seg.class_count[0] == 0) continue;
             const cyl_blob *b = &seg.blobs[seg.class_first[0]];  // largest of class 0
             work.resize(std::max<size_t>(16, cyl_noise_work_size_seg(&seg)));
-            cyl_centroid_noise out[3];
+            cyl_centroid_noise out[kEstimators];
             bool ok = true;
-            for (int e = 0; e < 3; e++)
-                if (cyl_noise_blob(&seg, b, (cyl_noise_estimator)e, work.data(), work.size(), &out[e]) != CYL_OK) ok = false;
+            for (int e = 0; e < kEstimators; e++) {
+                cyl_status st = e == CYL_NOISE_IMAGE
+                    ? cyl_noise_blob_image(&seg, b, &det.image(), &t, &det.obs_params.image_noise, &out[e])
+                    : cyl_noise_blob(&seg, b, (cyl_noise_estimator)e, work.data(), work.size(), &out[e]);
+                if (st != CYL_OK) ok = false;
+            }
             if (!ok) continue;
             cx.push_back(out[2].cx_px);
             cy.push_back(out[2].cy_px);
-            for (int e = 0; e < 3; e++) { sx[e] += out[e].var_x_px2; sy[e] += out[e].var_y_px2; }
+            for (int e = 0; e < kEstimators; e++) { sx[e] += out[e].var_x_px2; sy[e] += out[e].var_y_px2; }
             area += out[2].n;
         }
         size_t n = cx.size();
@@ -213,7 +220,7 @@ std::vector<VarianceRow> run_variance_tables(const Scene &base, const cyl_colort
             for (size_t i = 0; i < n; i++) { vx += (cx[i] - mx) * (cx[i] - mx); vy += (cy[i] - my) * (cy[i] - my); }
             row.actual_x = vx / (n - 1);
             row.actual_y = vy / (n - 1);
-            for (int e = 0; e < 3; e++) { row.est_x[e] = sx[e] / n; row.est_y[e] = sy[e] / n; }
+            for (int e = 0; e < kEstimators; e++) { row.est_x[e] = sx[e] / n; row.est_y[e] = sy[e] / n; }
             row.mean_area = area / n;
         }
         rows.push_back(row);

@@ -107,8 +107,11 @@ void plot_variance(const std::string &path, const std::vector<VarianceRow> &rows
 {
     double lo = 1e30, hi = 0;
     for (const VarianceRow &r : rows) {
-        for (double v : {r.actual_x, r.actual_y, r.est_x[0], r.est_x[1], r.est_x[2], r.est_y[0], r.est_y[1], r.est_y[2]})
+        for (double v : {r.actual_x, r.actual_y})
             if (v > 0) { lo = std::min(lo, v); hi = std::max(hi, v); }
+        for (int e = 0; e < kEstimators; e++)
+            for (double v : {r.est_x[e], r.est_y[e]})
+                if (v > 0) { lo = std::min(lo, v); hi = std::max(hi, v); }
     }
     if (hi <= 0) { lo = 1e-4; hi = 1; }
     lo = std::pow(10, std::floor(std::log10(lo))); hi = std::pow(10, std::ceil(std::log10(hi)));
@@ -119,9 +122,10 @@ void plot_variance(const std::string &path, const std::vector<VarianceRow> &rows
         if (f < 1) { a = ax.px(lo / f, lo); b = ax.px(hi, hi * f); }
         cv::line(ax.img, a, b, f == 1.0 ? cv::Scalar(0, 0, 0) : cv::Scalar(150, 150, 150), 1, cv::LINE_AA);
     }
-    const cv::Scalar col[3] = {cv::Scalar(0, 140, 255), cv::Scalar(200, 60, 0), cv::Scalar(0, 160, 0)};
+    const cv::Scalar col[kEstimators] = {cv::Scalar(0, 140, 255), cv::Scalar(200, 60, 0), cv::Scalar(0, 160, 0),
+                                         cv::Scalar(180, 0, 180)};
     for (const VarianceRow &r : rows)
-        for (int e = 0; e < 3; e++) {
+        for (int e = 0; e < kEstimators; e++) {
             if (r.actual_x > 0 && r.est_x[e] > 0) cv::circle(ax.img, ax.px(r.actual_x, r.est_x[e]), 5, col[e], 2, cv::LINE_AA);
             if (r.actual_y > 0 && r.est_y[e] > 0) {
                 cv::Point p = ax.px(r.actual_y, r.est_y[e]);
@@ -132,10 +136,11 @@ void plot_variance(const std::string &path, const std::vector<VarianceRow> &rows
     for (int i = 0; lo * std::pow(10.0, i) <= hi * 1.0001; i++) t.push_back(lo * std::pow(10.0, i));
     ax.frame("centroid variance: estimators vs measured", "measured variance (px^2)",
              "estimator mean (px^2)", t, t);
-    const char *nm[3] = {"uniform (eq. 4)", "column/row (eq. 5)", "local 3x3 (eq. 6)"};
-    for (int e = 0; e < 3; e++) ax.text(nm[e], cv::Point(ax.area.x + 10, ax.area.y + 20 + 20 * e), 0.45, col[e]);
-    ax.text("circles: x (horizontal), squares: y (vertical)", cv::Point(ax.area.x + 10, ax.area.y + 80));
-    ax.text("lines: y = x/2, x, 2x", cv::Point(ax.area.x + 10, ax.area.y + 100), 0.45, cv::Scalar(100, 100, 100));
+    const char *nm[kEstimators] = {"uniform (eq. 4)", "column/row (eq. 5)", "local 3x3 (eq. 6)",
+                                   "image (frame noise + table boundary)"};
+    for (int e = 0; e < kEstimators; e++) ax.text(nm[e], cv::Point(ax.area.x + 10, ax.area.y + 20 + 20 * e), 0.45, col[e]);
+    ax.text("circles: x (horizontal), squares: y (vertical)", cv::Point(ax.area.x + 10, ax.area.y + 100));
+    ax.text("lines: y = x/2, x, 2x", cv::Point(ax.area.x + 10, ax.area.y + 120), 0.45, cv::Scalar(100, 100, 100));
     ax.save(path);
 }
 

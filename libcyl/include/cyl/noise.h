@@ -45,7 +45,9 @@ extern "C" {
 typedef enum cyl_noise_estimator {
     CYL_NOISE_UNIFORM = 0,  /* eq. 4 */
     CYL_NOISE_COLUMN = 1,   /* eq. 5: columns for x, rows for y */
-    CYL_NOISE_LOCAL = 2     /* eq. 6: 3x3 neighbourhood (default; the paper's best) */
+    CYL_NOISE_LOCAL = 2,    /* eq. 6: 3x3 neighbourhood (the paper's best) */
+    CYL_NOISE_IMAGE = 3     /* the frame's own evidence: cyl_noise_blob_image() (needs the image and
+                               the colour table) */
 } cyl_noise_estimator;
 
 typedef struct cyl_centroid_noise {
@@ -56,6 +58,11 @@ typedef struct cyl_centroid_noise {
     uint32_t n;             /* samples in the blob */
     uint32_t box_w;         /* bounding box width, samples */
     uint32_t box_h;         /* bounding box height, samples */
+    double sigma_y;         /* CYL_NOISE_IMAGE: noise std of the frame's Y samples, given or estimated
+                               (with 8-bit rounding; at least min_sigma), levels (0 otherwise) */
+    double sigma_u;         /* CYL_NOISE_IMAGE: noise std of the U samples used, levels */
+    double sigma_v;         /* CYL_NOISE_IMAGE: noise std of the V samples used, levels */
+    uint32_t band_cells;    /* CYL_NOISE_IMAGE: grid cells simulated around the edges */
 } cyl_centroid_noise;
 
 /* Bytes of workspace cyl_noise_blob() needs for blobs at most max_box_w samples wide:
@@ -72,6 +79,55 @@ size_t cyl_noise_work_size_seg(const cyl_segmentation *seg);
  * index out of range), CYL_ERR_EMPTY (no samples) or CYL_ERR_NOMEM (work too small). */
 cyl_status cyl_noise_blob(const cyl_segmentation *seg, const cyl_blob *b, cyl_noise_estimator est,
                           void *work, size_t work_size, cyl_centroid_noise *out);
+
+/* ---- CYL_NOISE_IMAGE: the variance the frame itself predicts ------------------------------------
+ *
+ * Eqs. 4-6 see only the blob's shape; the frame-to-frame scatter of a centroid depends on how close
+ * each edge pixel's colour is to the colour table's boundary, relative to the sensor noise. This
+ * estimator measures both in the frame (docs/uncertainty.md, "The image estimator"):
+ *   1. noise: the std of Y, U and V from second differences along the blob's interior (robust:
+ *      values beyond 4 robust sigmas are dropped), at most 8 places per run, so O(runs);
+ *   2. edges: every grid cell within band_px cells (Chebyshev) of both a blob cell and a non-blob
+ *      cell is re-classified `draws` times with the observed value plus Gaussian noise of that std
+ *      (deterministic draws from a hash of the cell; chroma draws shared by the pixels that share a
+ *      chroma sample), through the same colour table and class precedence as cyl_segment;
+ *   3. per row, each draw is run-length encoded again as cyl_segment would (runs shorter than
+ *      min_run_px dropped; a run counts if it touches the blob's runs in this or a neighbouring
+ *      row, or lies within the class's merge gap of the blob's box), giving the row's moments
+ *      sum (x - m_x) and sum (y - m_y);
+ *   4. VAR(m_x) = sum over rows of the draws' variance of the row moment / n^2 (rows that share
+ *      chroma samples, as in 4:2:0, are summed before the variance), likewise VAR(m_y).
+ * This is eq. 3's sum ((i - m_x)/n)^2 rho (1 - rho) with rho taken from the frame instead of the
+ * shape, plus the correlations of a row's cells. Cost O(band cells x draws) = O(perimeter).
+ * Interior cells farther than band_px from every edge are taken as certain. */
+typedef struct cyl_noise_image_params {
+    double sigma_y;          /* noise std of the Y samples, levels, including 8-bit rounding (the draws
+                                add sqrt(sigma^2 - 1/12) and round); 0 = estimate from the blob (default 0) */
+    double sigma_u;          /* ... of the U samples, levels; 0 = estimate (default 0) */
+    double sigma_v;          /* ... of the V samples, levels; 0 = estimate (default 0) */
+    double fallback_sigma;   /* levels, for a channel the blob has too few interior samples to
+                                estimate (default 2.5) */
+    double min_sigma;        /* floor on every std used for the draws, levels (default 0.1) */
+    uint32_t band_px;        /* half-width of the simulated band around the edges, grid cells, 1..4
+                                (default 4: chosen from 1..4 on the tuning sweep, seed 1) */
+    uint32_t draws;          /* simulated frames, 2..64 (default 32) */
+    uint32_t min_run_px;     /* the segmentation's min_run_px (default 3) */
+    int32_t merge_gap_px;    /* the class's merge_gap_px (default 3; < 0: no merging): a simulated run
+                                within this gap of the blob's box joins it, as cyl_segment's merging
+                                would; otherwise only runs touching the blob count */
+} cyl_noise_image_params;
+
+/* The defaults above. */
+cyl_noise_image_params cyl_noise_image_params_default(void);
+
+/* Centroid and its variance for blob b of seg by CYL_NOISE_IMAGE. img and t must be the frame and
+ * colour table seg was made from (same ROI grid). No workspace. Returns CYL_OK, CYL_ERR_ARG (NULL,
+ * bad parameters, runs as for cyl_noise_blob, a blob outside the image), CYL_ERR_EMPTY, or the
+ * image's cyl_image_check() error. A blob with a row of more than 64 run intervals in its band
+ * (a very ragged blob) gets the CYL_NOISE_LOCAL variance instead, and band_cells = 0. */
+cyl_status cyl_noise_blob_image(const cyl_segmentation *seg, const cyl_blob *b, const cyl_image *img,
+                                const cyl_colortable *t, const cyl_noise_image_params *p,
+                                cyl_centroid_noise *out);
 
 #ifdef __cplusplus
 }

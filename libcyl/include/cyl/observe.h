@@ -59,6 +59,11 @@ typedef struct cyl_observe_params {
                                                    10 (sigma_r/r)^2; <= 0 disables) */
     cyl_landmark_size size[CYL_MAX_CLASSES];    /* physical size of each class's landmarks, m
                                                    (default 0 = unknown) */
+    /* CYL_NOISE_IMAGE only: the frame and colour table seg was made from, and the estimator's
+     * settings (cyl_noise_blob_image). Both pointers must be set for that estimator. */
+    const cyl_image *image;                     /* default NULL */
+    const cyl_colortable *table;                /* default NULL */
+    cyl_noise_image_params image_noise;         /* default cyl_noise_image_params_default() */
 } cyl_observe_params;
 
 typedef struct cyl_observation {
