@@ -1,5 +1,6 @@
 /* libcyl -- blobs to observations. */
 #include "cyl/observe.h"
+#include "cyl/silhouette.h"
 #include "unc_internal.h"
 
 #include <math.h>
@@ -15,6 +16,8 @@ cyl_observe_params cyl_observe_params_default(void)
     p.min_area = 1;
     p.min_var_px2 = 0.0;
     p.nonlinear_rel_sigma = 0.055;
+    p.silhouette_rel_sigma = 0.25;
+    p.silhouette_sigma_px = 0.25;
     p.image_noise = cyl_noise_image_params_default();
     return p;
 }
@@ -23,6 +26,36 @@ size_t cyl_observe_work_size(const cyl_segmentation *seg, const cyl_observe_para
 {
     if (!p || p->estimator != CYL_NOISE_COLUMN) return 0;
     return cyl_noise_work_size_seg(seg);
+}
+
+/* The silhouette's geometric bias (cyl/silhouette.h) taken out of the measurement point: the
+ * offset at the landmark's position, which comes from the point itself, so twice (the second
+ * pass moves the offset by < 0.01 px in the synthetic scene). The offset's variance is added to
+ * the centroid's. On any failure the uncorrected result stays. */
+static void correct_silhouette(cyl_observation *o, const cyl_camera *cam, const cyl_observe_params *p,
+                               const cyl_landmark_size *size, cyl_rb_result *rb)
+{
+    int it;
+    for (it = 0; it < 2; it++) {
+        cyl_silhouette_bias sb;
+        cyl_rb_result r2;
+        double u, v, vu, vv;
+        if (cyl_silhouette_bias_at(cam, rb->x_m, rb->y_m, size, p->silhouette_rel_sigma, p->silhouette_sigma_px, &sb) != CYL_OK) return;
+        u = o->centroid_u_px - sb.du_px;
+        v = o->centroid_v_px - sb.dv_px;
+        vu = (o->var_u_px2 - o->bias_var_u_px2) + sb.var_u_px2;
+        vv = (o->var_v_px2 - o->bias_var_v_px2) + sb.var_v_px2;
+        if (cyl_rb_compute(cam, p->model, u, v, vu, vv, 0.0, &r2) != CYL_OK) return;
+        *rb = r2;
+        o->u_px = u;
+        o->v_px = v;
+        o->var_u_px2 = vu;
+        o->var_v_px2 = vv;
+        o->bias_u_px = sb.du_px;
+        o->bias_v_px = sb.dv_px;
+        o->bias_var_u_px2 = sb.var_u_px2;
+        o->bias_var_v_px2 = sb.var_v_px2;
+    }
 }
 
 static const int calib_in[CYL_CALIB_COUNT] = {CYL_IN_FX, CYL_IN_FY, CYL_IN_CX, CYL_IN_CY,
@@ -94,13 +127,16 @@ cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
         o->flags = b->flags & (CYL_BLOB_TOUCH_ANY | CYL_BLOB_MERGED);
         if (b->flags & CYL_BLOB_TOUCH_ANY) o->flags |= CYL_OBS_CUT;
         o->area = cn.n;
-        o->u_px = cn.cx_px;
-        o->v_px = cn.cy_px;
+        o->centroid_u_px = o->u_px = cn.cx_px;
+        o->centroid_v_px = o->v_px = cn.cy_px;
         o->var_u_px2 = cn.var_x_px2 > p->min_var_px2 ? cn.var_x_px2 : p->min_var_px2;
         o->var_v_px2 = cn.var_y_px2 > p->min_var_px2 ? cn.var_y_px2 : p->min_var_px2;
         o->w_px = (double)cn.box_w * (double)seg->x_step;
         o->h_px = (double)cn.box_h * (double)seg->y_step;
         st = cyl_rb_compute(cam, p->model, o->u_px, o->v_px, o->var_u_px2, o->var_v_px2, 0.0, &rb);
+        if (st == CYL_OK && p->silhouette_rel_sigma >= 0.0 && p->silhouette_sigma_px >= 0.0 && !(o->flags & CYL_OBS_CUT) &&
+            p->size[b->cls].diameter_m > 0.0 && p->size[b->cls].height_m > 0.0)
+            correct_silhouette(o, cam, p, &p->size[b->cls], &rb);
         if (st == CYL_ERR_NO_RANGE) {
             o->flags |= CYL_OBS_NO_RANGE;
             o->bearing_rad = rb.bearing_rad;

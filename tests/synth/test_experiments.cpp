@@ -115,12 +115,13 @@ TEST(SynthExperiments, CentroidBiasIsMeasuredAndSmall)
     c.calibration_error = false;
     std::vector<RbSample> s = run_range_bearing(scene(), table(), c);
     ASSERT_GE(s.size(), 100u);
-    double dv_far = 0, dr_axis = 0, dr_face = 0;
-    int n_far = 0;
+    double dv_far = 0, dr_axis = 0, dr_face = 0, dv_near = 0, dv_near_point = 0;
+    int n_far = 0, n_near = 0;
     for (const RbSample &r : s) {
         dr_axis += r.range_m - r.axis_range_m;
         dr_face += r.range_m - r.true_range_m;
         if (r.axis_range_m > 2.0) { dv_far += r.dv_centre_px; n_far++; }
+        if (r.axis_range_m < 1.2) { dv_near += r.dv_centre_px; dv_near_point += r.dv_point_px; n_near++; }
     }
     dr_axis /= s.size();
     dr_face /= s.size();
@@ -130,9 +131,21 @@ TEST(SynthExperiments, CentroidBiasIsMeasuredAndSmall)
     EXPECT_LT(std::fabs(dv_far / n_far), 0.5);
     EXPECT_LT(std::fabs(dr_axis), 0.025);
     EXPECT_GT(dr_face, 0.03);
-    // with the calibration exact the pixel-noise sigmas alone do not cover that bias
+    // near 1 m the blob centroid lies 1-2 px above the projected centre; the modelled silhouette
+    // bias (cyl/silhouette.h) takes most of it out of the measurement point
+    ASSERT_GT(n_near, 5);
+    std::printf("  below 1.2 m: centroid dv %.3f px, measurement point dv %.3f px (n %d)\n", dv_near / n_near,
+                dv_near_point / n_near, n_near);
+    EXPECT_LT(dv_near / n_near, -0.8);
+    EXPECT_GT(dv_near_point / n_near, -0.5);
+    // with the bias's own uncertainty the pixel-noise sigmas cover the error (the NEES of 2 dof:
+    // mean 2; without the model it was 48.8 with the local estimator)
     RbStats st = rb_stats(s);
-    EXPECT_LT(st.range_frac2, 0.5);
+    std::printf("  pixel noise only: range within 2 sigma %.3f, bearing %.3f, mean NEES %.2f\n", st.range_frac2,
+                st.bearing_frac2, st.mean_nees);
+    EXPECT_GT(st.range_frac2, 0.85);
+    EXPECT_GT(st.bearing_frac2, 0.85);
+    EXPECT_LT(st.mean_nees, 3.0);
 }
 
 TEST(SynthExperiments, ConfidenceSeparatesLandmarksFromClutter)

@@ -76,6 +76,10 @@ struct RbSample {
     double range_m = 0, bearing_rad = 0;             // measured
     double cov_rr = 0, cov_rb = 0, cov_bb = 0;
     double du_centre_px = 0, dv_centre_px = 0;       // blob centroid - projection of the landmark centre
+    double du_point_px = 0, dv_point_px = 0;         // measurement point (centroid less the modelled
+                                                     // silhouette bias) - projection of the centre
+    double bias_u_px = 0, bias_v_px = 0;             // the modelled silhouette bias taken out
+    double var_centroid_u = 0, var_centroid_v = 0;   // the estimator's centroid variance, px^2
     double var_u = 0, var_v = 0;
     double confidence = 0;
 };
@@ -85,6 +89,8 @@ struct RbConfig {
     double range_min_m = 0.8, range_max_m = 4.0;
     bool calibration_error = true;  // false: pixel-noise-only (estimator camera exact, sigmas 0)
     uint64_t seed = 7;
+    cyl_noise_estimator estimator = CYL_NOISE_IMAGE;  // the frontend's default
+    double silhouette_rel_sigma = 0.25;               // cyl_observe_params.silhouette_rel_sigma
 };
 std::vector<RbSample> run_range_bearing(const Scene &base, const cyl_colortable &t, const RbConfig &c);
 

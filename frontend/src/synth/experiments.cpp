@@ -287,7 +287,8 @@ std::vector<RbSample> run_range_bearing(const Scene &base, const cyl_colortable 
         double gain = ren.frame_gain(cfg.seed, run, run * 3.7);
         ren.render_yuyv(robot, gain, mix_seed(cfg.seed, run, 0xF00D), frame);
         det.segment(frame.data());
-        const std::vector<cyl_observation> &obs = det.observe(cam, CYL_NOISE_LOCAL);
+        det.obs_params.silhouette_rel_sigma = cfg.silhouette_rel_sigma;
+        const std::vector<cyl_observation> &obs = det.observe(cam, cfg.estimator);
         for (size_t k = 0; k < sc.cylinders.size(); k++) {
             const Cylinder &c = sc.cylinders[k];
             const cyl_observation *best = nullptr;
@@ -311,8 +312,14 @@ std::vector<RbSample> run_range_bearing(const Scene &base, const cyl_colortable 
             r.cov_bb = best->cov_rb[1][1];
             double pc[3] = {c.x_m, c.y_m, c.height_m / 2}, u, v;
             project_point(truth, cp, pc, &u, &v);
-            r.du_centre_px = best->u_px - u;
-            r.dv_centre_px = best->v_px - v;
+            r.du_centre_px = best->centroid_u_px - u;
+            r.dv_centre_px = best->centroid_v_px - v;
+            r.du_point_px = best->u_px - u;
+            r.dv_point_px = best->v_px - v;
+            r.bias_u_px = best->bias_u_px;
+            r.bias_v_px = best->bias_v_px;
+            r.var_centroid_u = best->var_u_px2 - best->bias_var_u_px2;
+            r.var_centroid_v = best->var_v_px2 - best->bias_var_v_px2;
             r.var_u = best->var_u_px2;
             r.var_v = best->var_v_px2;
             r.confidence = best->confidence;

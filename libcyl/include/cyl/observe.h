@@ -64,6 +64,15 @@ typedef struct cyl_observe_params {
     const cyl_image *image;                     /* default NULL */
     const cyl_colortable *table;                /* default NULL */
     cyl_noise_image_params image_noise;         /* default cyl_noise_image_params_default() */
+    double silhouette_rel_sigma;                /* the silhouette's geometric bias (cyl/silhouette.h)
+                                                   is taken out of the measurement point of every
+                                                   uncut blob of a class with a size, with this
+                                                   relative uncertainty (default 0.25: a prior, not
+                                                   tuned); < 0: not corrected */
+    double silhouette_sigma_px;                 /* and this absolute one, px: what is not geometry
+                                                   (shading, the table's erosion, chroma subsampling;
+                                                   default 0.25, chosen on the synthetic scene's
+                                                   tuning seeds 1-20, docs/uncertainty.md) */
 } cyl_observe_params;
 
 typedef struct cyl_observation {
@@ -71,10 +80,18 @@ typedef struct cyl_observation {
     uint8_t cls;                /* class index */
     uint32_t flags;             /* CYL_BLOB_TOUCH_*, CYL_BLOB_MERGED, CYL_OBS_* bits */
     uint32_t area;              /* samples in the blob */
-    double u_px;                /* measurement point (centroid) column, px */
+    double u_px;                /* measurement point column, px: the blob's centroid less the
+                                   silhouette's bias (centroid_u_px - bias_u_px) */
     double v_px;                /* measurement point row, px */
-    double var_u_px2;           /* variance of u_px, px^2 */
+    double var_u_px2;           /* variance of u_px, px^2: the centroid's (at least min_var_px2)
+                                   plus bias_var_u_px2 */
     double var_v_px2;           /* variance of v_px, px^2 */
+    double centroid_u_px;       /* the blob's centroid, column, px */
+    double centroid_v_px;       /* the blob's centroid, row, px */
+    double bias_u_px;           /* silhouette bias taken out, u, px (0: none; cyl/silhouette.h) */
+    double bias_v_px;           /* silhouette bias taken out, v, px (< 0: centroid above the centre) */
+    double bias_var_u_px2;      /* its variance, px^2 (part of var_u_px2) */
+    double bias_var_v_px2;      /* likewise v, px^2 */
     double range_m;             /* range from the robot centre, m (0 if CYL_OBS_NO_RANGE) */
     double bearing_rad;         /* bearing from the robot centre, rad, left positive */
     double cov_rb[2][2];        /* covariance of (range_m, bearing_rad): m^2, m rad; m rad, rad^2 */

@@ -1,0 +1,56 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* libcyl -- the geometric bias of a landmark's blob centroid, modelled.
+ *
+ * The range and bearing of cyl_observe() come from the ray through the blob's centroid, taken as
+ * the image of the landmark's centre (its axis at the centroid plane). It is not: the silhouette of
+ * a vertical cylinder seen from above its top runs from the front of its base to the back of its
+ * top, and perspective makes its near parts larger, so the silhouette's centroid lies above (and, off
+ * the image centre, beside) the image of the centre -- 1.5 px at 1 m in the synthetic scene, which
+ * is several sigmas of the centroid's noise (docs/synthetic.md, "Bias of the blob centroid").
+ *
+ * cyl_silhouette_bias() computes that offset from the geometry alone: the camera (intrinsics, lens,
+ * tilt, yaw, height, offset), the landmark's size and its position. A cylinder is convex, so its
+ * silhouette is the convex hull of the images of its top and bottom circles (exactly so in the
+ * pinhole's normalised coordinates, where the hull is found); the hull's outline is then taken
+ * through the lens model (each edge in 8 pieces) and the area centroid computed in pixels, so a
+ * tall blob low in a barrel-distorted image has its centroid pulled up as in the image.
+ * The offset is returned with a variance for what the model does not know: (rel_sigma x offset)^2
+ * for the landmark's true size and shape, plus sigma_px^2 for what is not geometry (shading, the
+ * colour table's erosion of the silhouette, the chroma subsampling), per axis.
+ */
+#ifndef CYL_SILHOUETTE_H
+#define CYL_SILHOUETTE_H
+
+#include "cyl/status.h"
+#include "cyl/camera.h"
+#include "cyl/confidence.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Points per circle of the hull (top and bottom): the hull's area is within 0.3% of the true one. */
+#define CYL_SILHOUETTE_POINTS 48
+
+typedef struct cyl_silhouette_bias {
+    double du_px;          /* silhouette centroid minus the image of the centre, u (right), px */
+    double dv_px;          /* likewise v (down), px; < 0: the centroid lies above the centre */
+    double var_u_px2;      /* variance of du_px: (rel_sigma du_px)^2 + sigma_px^2, px^2 */
+    double var_v_px2;      /* variance of dv_px: (rel_sigma dv_px)^2 + sigma_px^2, px^2 */
+    double area_px2;       /* the silhouette's area in the image, px^2 */
+} cyl_silhouette_bias;
+
+/* The offset for a landmark of this size standing with its centre at robot-frame (x_m, y_m) on
+ * the centroid plane (the plane cam->height_m below the optical centre; the cylinder reaches
+ * height_m/2 above and below it). rel_sigma >= 0: the offset's relative uncertainty; sigma_px >= 0:
+ * its absolute uncertainty, px. Returns CYL_OK, CYL_ERR_ARG (NULL, size <= 0 or non-finite,
+ * rel_sigma or sigma_px < 0 or non-finite), the camera's
+ * cyl_camera_check() error, or CYL_ERR_NO_RANGE when part of the landmark is not in front of the
+ * camera. */
+cyl_status cyl_silhouette_bias_at(const cyl_camera *cam, double x_m, double y_m, const cyl_landmark_size *size,
+                                  double rel_sigma, double sigma_px, cyl_silhouette_bias *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
