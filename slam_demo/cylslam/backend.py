@@ -182,6 +182,8 @@ class Params:
     init_max_sigma: float = 0.5    # m, no new landmark from an observation less precise than this
     max_cands: int = 4             # at most this many nearest candidates per observation
     reject_flags: int = FLAGS_REJECT  # obs.flags bits that drop an observation (format: 0x320)
+    max_range_rel_sigma: Optional[float] = None  # drop an observation whose range sigma exceeds this
+                                   # times its range (its range is then far from Gaussian); None: keep
     robust: str = "none"           # none | huber
     huber_k: float = 1.345         # Huber threshold on the whitened residual
     fixed_cov: Optional[np.ndarray] = None   # replaces every observation covariance (r, b order)
@@ -257,7 +259,7 @@ class Slam:
         id_to_lm = {}
         by_class = {}
         assoc = []
-        st = dict(obs_total=0, dropped_flags=0, dropped_no_range=0, dropped_confidence=0,
+        st = dict(obs_total=0, dropped_flags=0, dropped_no_range=0, dropped_confidence=0, dropped_far=0,
                   dropped_ambiguous=0, dropped_imprecise=0, used=0, new_landmarks=0, isam_updates=0,
                   marginal_calls=0, association=mode)
         last_update = 0
@@ -284,6 +286,9 @@ class Slam:
                     st["dropped_no_range"] += 1
                 elif o.confidence < p.conf_min:
                     st["dropped_confidence"] += 1
+                elif (p.max_range_rel_sigma is not None and
+                      math.sqrt(max(o.cov[0, 0], 0.0)) > p.max_range_rel_sigma * o.range_m):
+                    st["dropped_far"] += 1
                 else:
                     usable.append(o)
             need = bool(usable) and mode == "unknown"

@@ -84,3 +84,17 @@ def test_real_frontend_log_reads_unchanged():
     m = metrics.evaluate(ds, res)
     assert m["association_errors"] == 0 and m["clutter_used"] == 0
     assert m["ate_m"] < 0.02 and m["landmark_rmse_m"] < 0.1
+
+
+def test_fixed_covariance_that_maps_nothing_is_reported_failed(monkeypatch, capsys):
+    # A fixed covariance 1e-12 times the mean gates every observation out: no landmark is mapped,
+    # so that run is no baseline (its "ATE" would be dead reckoning's) and is reported as failed.
+    from cylslam import cli
+    monkeypatch.setattr(cli, "FIXED_GRID", (1e-12,))
+    ds = read_obslog(SHORT)
+    args = cli.build_parser().parse_args(["run", SHORT, "--no-plot", "--fixed-cov", "grid"])
+    s = cli.process(ds, args, "t", None)
+    assert "fixed_cov_failed" in s and "ate_fixed_cov_m" not in s
+    cli.print_summary(s)
+    assert "FAILED" in capsys.readouterr().out
+    assert not any("fixed-cov" in f for f in cli.check_synthetic(s))
