@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # libcyl -- top-level build. The two commands a user needs:
 #   make demo    the main job, on built-in data
 #   make test    the whole test suite (what CI runs)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The benchmarks' shared frames and timing helpers (bench_segment, bench_uncertainty):
 // distinct deterministic 640x480 YUYV frames with coloured rectangles (upright "cylinders" and
 // neutral clutter), sensor noise and speckle, and the colour table that finds their two colours.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Segmentation benchmark: libcyl (classify + RLE + blobs) against the floor (a
 // memcpy of the frame) and the OpenCV pipeline a user would write instead
 // (cvtColor YUYV->BGR, inRange per class, connectedComponentsWithStats per

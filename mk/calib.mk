@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Calibration tools (issue 6, docs/calibration.md):
 #   build/cyl-calibrate   intrinsics (Ceres, full covariance) and the robot mount's extrinsics
 #   build/cyl-train       colour-table training (command line and interactive window)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # make embedded: the core as firmware uses it.
 #  1. libcyl for a Cortex-M4 (arm-none-eabi-gcc -Os -Werror, `make cross`), nm check that the
 #     archive references no heap, stdio or exit, and its code size;

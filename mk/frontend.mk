@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # The C++ frontend: frontend/src/*.cpp -> $(BUILD)/frontend/libfrontend.a; tools in frontend/tools/.
 FRONTEND_SRCS := $(sort $(wildcard frontend/src/*.cpp))
 FRONTEND_OBJS := $(FRONTEND_SRCS:frontend/src/%.cpp=$(BUILD)/frontend/%.o)

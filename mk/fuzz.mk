@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Fuzzing with libFuzzer (Debian's clang): targets in tests/fuzz/, seed corpora in
 # tests/fuzz/corpus/<target>/ (committed). Findings are written to build/fuzz/findings/.
 #   make fuzz-smoke            each target for FUZZ_SECONDS (default 60) -- part of CI

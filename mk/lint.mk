@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # make lint: static analysis of libcyl and the frontend; any finding fails (CI runs it).
 #   cppcheck (warning, style, performance, portability) and clang-tidy (checks in .clang-tidy).
 DEBS_LINT := cppcheck clang-tidy
@@ -12,4 +13,6 @@ lint: $(STAMP)/debs-lint $(STAMP)/debs-cv $(STAMP)/debs-calib
 	clang-tidy --quiet $(LINT_C) -- -std=c99 -Ilibcyl/include
 	clang-tidy --quiet $(LINT_CXX) -- -std=c++17 -Ilibcyl/include -Ifrontend/include -Itests/common -I/usr/include/eigen3 $(CV_FLAGS)
 	@echo "lint: cppcheck and clang-tidy clean on $(words $(LINT_C)) C and $(words $(LINT_CXX)) C++ files"
+	@scripts/spdx.py --check
+	@test -f LICENSE && test -f CITATION.cff && echo "lint: LICENSE (BSD-3-Clause) and CITATION.cff present"
 .PHONY: lint

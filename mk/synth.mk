@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # The synthetic camera with ground truth and the paper's consistency experiments (issue 4;
 # docs/synthetic.md).
 #   make render      render the default drive (1000 frames) into build/drive.cylraw

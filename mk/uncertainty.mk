@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # libcyl uncertainty model (issue 3): C++ calibration loader, the paper tool, OpenCV tests.
 #   make paper       the paper's Tables 6, 8, 9 beside ours; last line JSON
 # Test programs added to `make test`: build/tests/test_undistort_cv, build/tests/test_calibration.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # make bench: every benchmark in one run; each prints its table, and the last line is one JSON
 # object merging all their figures. Timing figures are medians and ratios against baselines
 # measured in the same run (memcpy, OpenCV); instruction counts come from callgrind.

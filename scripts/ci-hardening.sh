@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # make ci-hardening (issue 8), run by .ci/run after `make test`: the whole suite under
 # AddressSanitizer + UndefinedBehaviorSanitizer, the firmware build and the second architecture,
 # 60 s of fuzzing per target, static analysis, and the 10,000-frame soak. The steps run one after

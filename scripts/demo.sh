@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # make demo: the whole system on built-in data.
 #   1. render a synthetic drive (1000 frames, 16 landmarks in 2 colours, clutter) with a camera
 #      whose true mount differs from its calibration by one error drawn from the calibration's

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Install the Debian packages named on the command line that are not installed yet.
 # Idempotent: prints nothing and does nothing when all are present. Runs apt-get
 # update once, only when something is missing. Uses sudo when not root.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Run each libFuzzer target for N seconds on a copy of its committed corpus (the committed
 # seeds are never modified). Exit non-zero on any crash, leak, timeout or sanitizer report.
 set -uo pipefail

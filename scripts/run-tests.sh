@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Run test programs (cmocka, GoogleTest or pytest; "prog:arg:..." passes arguments), print each one's result and
 # a closing "N passed, N failed" line. Exit non-zero if anything failed or crashed.
 set -u

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # V4L2 against a real driver: boot Debian's own kernel under qemu (software emulation), load
 # the kernel's vivid driver from a small initramfs and run the test program build/vivid_test
 # inside (static; or dynamic with its libraries copied in, as `make test SAN=1` builds it). The kernel package is fetched with apt-get download (Debian's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cylfe: camera calibration files (see calibration.hpp).
 #include "cylfe/calibration.hpp"
 

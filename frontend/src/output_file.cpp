@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "cylfe/output_file.hpp"
 #include "cylfe/error.hpp"
 

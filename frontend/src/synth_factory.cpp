@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // open_source("synthetic[:SEED]"): the synthetic scene of cylfe::synth (frontend/src/synth/).
 #include "cylfe/sources.hpp"
 #include "cylfe/synth.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // V4L2 capture. Every ioctl is checked, EINTR retried, buffers released on every exit path.
 #include "cylfe/v4l2.hpp"
 #include "cylfe/error.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cyl: the libcyl command-line frontend. `cyl --help` lists the commands.
 #include <cerrno>
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cyl-calibrate: camera intrinsics from chessboard images (Ceres, with the full covariance), and
 // the robot mount's extrinsics from a chessboard lying on the floor. docs/calibration.md.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cyl_paper: the paper's Tables 6, 8 and 9 recomputed with libcyl's uncertainty model, printed
 // beside the paper's own figures. The camera comes from a calibration file (default
 // calib_data/paper_camera.yaml, the paper's Table 4/5 camera). The last line is a JSON object.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cyl-render: render a synthetic drive (frames, odometry, ground truth) into a raw frame log
 // (*.cylraw, docs/formats.md); also writes scene files, the scene's colour table and camera.
 #include "cylfe/error.hpp"

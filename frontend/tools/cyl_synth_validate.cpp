@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cyl-synth-validate: the paper's consistency experiments on the synthetic camera (make validate).
 // Prints Tables 1-3 and 6-7 in the paper's layout beside the paper's figures, the blob-centroid
 // bias, the confidence check; writes PNG plots and CSVs into --out; the last line of stdout is a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cyl-train: colour-table training (paper section 3.3) from image files or raw-log frames, on the
 // command line or interactively in a window. Writes libcyl's CYLT table. docs/calibration.md.
 #include <cmath>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl example: train a colour table from a region, segment a frame, print its blobs.
  *
  * Everything the core needs comes from the caller: the table (a plain struct),

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* How much memory libcyl needs for one frame on this target: the numbers firmware sizes its
  * static buffers with. Prints a table for a 320x240 frame (or the size given as arguments). */
 #include <stdio.h>

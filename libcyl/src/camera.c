@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- camera model: Brown-Conrady distortion, its inverse and Jacobians. */
 #include "cyl/camera.h"
 

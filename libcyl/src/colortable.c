@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 #include "cyl/colortable.h"
 #include "internal.h"
 #include <string.h>

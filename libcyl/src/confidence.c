@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- landmark confidence (paper eqs. 7-8). */
 #include "cyl/confidence.h"
 #include "cyl/segment.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl internal helpers (not installed). */
 #ifndef CYL_INTERNAL_H
 #define CYL_INTERNAL_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Generated: index of the lowest set bit of a class mask, 0xFF for none. */
 #ifndef CYL_LOWBIT_H
 #define CYL_LOWBIT_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- centroid variance estimators (paper eqs. 3-6). */
 #include "cyl/noise.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- centroid variance from the frame's own evidence (CYL_NOISE_IMAGE, cyl/noise.h). */
 #include "cyl/noise.h"
 #include "internal.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- blobs to observations. */
 #include "cyl/observe.h"
 #include "cyl/silhouette.h"

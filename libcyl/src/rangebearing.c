@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- range, bearing and their covariance (paper section 2.3.2). */
 #include "cyl/rangebearing.h"
 #include "unc_internal.h"

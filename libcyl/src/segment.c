@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Run-length encoding, 4-connected union-find over runs, blob statistics,
  * merging and sorting. See cyl/segment.h for the contract.
  *

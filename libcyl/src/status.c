@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 #include "cyl/status.h"
 
 const char *cyl_status_str(cyl_status s)

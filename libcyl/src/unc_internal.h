@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl uncertainty model: helpers shared by rangebearing.c and observe.c (not installed). */
 #ifndef CYL_UNC_INTERNAL_H
 #define CYL_UNC_INTERNAL_H

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """cylslam: landmark SLAM back end for libcyl observation logs (and MRCLAM / Victoria Park).
 
 Modules: data (common in-memory model), obslog (docs/formats.md JSON Lines reader/writer),

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The GTSAM back end: Pose2 chain, one BearingRangeFactor2D per observation with its own
 covariance, iSAM2 incrementally, a final batch Levenberg-Marquardt pass, data association.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Command line: python -m cylslam {run,synth,mrclam,victoria,excerpt} --help
 
 Exit codes: 0 success; 1 an acceptance check asked for with --check failed; 2 usage error;

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The common in-memory model every reader produces and the back end consumes.
 
 A data set is a list of steps (one robot pose each). Step 0 is the start pose; every later step

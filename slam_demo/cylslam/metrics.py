@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Metrics against ground truth.
 
 - Position RMSE (ATE): sqrt(mean |p_est - p_true|^2) over the poses that have truth, in the

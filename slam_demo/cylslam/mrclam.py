@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Reader of one robot of the UTIAS MRCLAM data set (Leung, Halpern, Barfoot, Liu, IJRR 2011).
 
 Files (4 '#' header lines, whitespace-separated columns): Barcodes.dat (subject, barcode),

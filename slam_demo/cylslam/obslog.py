@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Reader and writer of the observation log (docs/formats.md, `cyl-observations` version 1).
 
 Malformed lines. Default (strict): the reader stops at the first malformed line and raises

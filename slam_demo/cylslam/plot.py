@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """PNG plot of the estimate against ground truth with 95 % ellipses."""
 from __future__ import annotations
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Synthetic observation logs in the docs/formats.md format, with ground truth.
 
 Stand-in for the renderer + frontend until real logs exist. Everything is drawn from documented

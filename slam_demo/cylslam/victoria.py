@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Reader of gtsam's Victoria Park file (`gtsam.findExampleDataFile('victoria_park.txt')`, shipped
 in the gtsam wheel as gtsam/Data/victoria_park.txt).
 

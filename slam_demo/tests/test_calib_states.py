@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The calibration error as a state (backend.calib_factor): Jacobians against central
 differences, the factor's residual and Jacobians through GTSAM's linearisation, the log fields,
 and the effect on a real frontend log whose camera has a calibration error."""

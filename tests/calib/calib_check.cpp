@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // make calib-check: cyl-calibrate's intrinsics against cv::calibrateCamera on OpenCV's own sample
 // images (tests/fixtures/opencv_left), the Monte Carlo of the reported sigmas, and the mount
 // extrinsics on synthetic floor renders. The last line printed is a JSON object.

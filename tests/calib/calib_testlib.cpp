@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Test support for the calibration tools (calib_testlib.hpp).
 #include "calib_testlib.hpp"
 

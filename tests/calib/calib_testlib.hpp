@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Test support for the calibration tools: the comparison with cv::calibrateCamera, the Monte
 // Carlo of the intrinsic sigmas, and a floor-chessboard renderer with its own camera geometry
 // (OpenCV's lens model, independent of libcyl's) for the mount extrinsics.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The interactive colour-table trainer (cyl-train --gui) under a headless X server: scripted
 # mouse drags and keys (xdotool), screenshots of the X screen (ImageMagick's import) checked
 # pixel by pixel, and the saved table checked byte by byte.

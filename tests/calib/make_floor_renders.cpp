@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Writes renders of a 9x6 chessboard (7 cm squares) lying on the floor 1 m ahead of the robot, seen
 // by the synthetic scene's default camera (cylfe::synth::CameraModel defaults), one per simulated
 // start-up (the true tilt, yaw, height jittered by 0.5 deg, 0.4 deg, 0.3 mm), plus that camera's

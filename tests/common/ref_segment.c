@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 #include "ref_segment.h"
 #include <stdlib.h>
 #include <string.h>

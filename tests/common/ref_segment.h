@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Brute-force reference segmentation for tests: per-pixel classification
  * through cyl_image_pixel(), per-row run filtering, flood-fill labelling of
  * 4-connected samples of one class. Slow and obvious on purpose. No merging. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Deterministic random numbers for tests (xoshiro256** seeded by splitmix64). */
 #ifndef CYL_TEST_RNG_H
 #define CYL_TEST_RNG_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 #include "synth_frames.h"
 #include <math.h>
 #include <stdlib.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Synthetic YUV frames for tests and benchmarks: draw on a full-resolution
  * YUV canvas, then convert to any libcyl pixel format with any stride. */
 #ifndef CYL_TEST_SYNTH_FRAMES_H

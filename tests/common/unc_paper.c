@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 #include "unc_paper.h"
 
 void unc_paper_camera(cyl_camera *cam)

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* The paper's Pioneer camera (Tables 4 and 5) for the uncertainty tests, plus the choices
  * documented in docs/uncertainty.md (s, its sigma, image size, no distortion). The same values
  * are in calib_data/paper_camera.yaml, which the C++ tools read. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Calibration files -> cyl_camera: the paper camera, OpenCV files without libcyl's fields, ROS
 // camera_info, save/load round trip, and errors that name the file and the field.
 #include <gtest/gtest.h>

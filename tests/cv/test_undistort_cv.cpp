@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // libcyl's C undistortion and projection against OpenCV (cv::undistortPoints, cv::projectPoints)
 // over the whole image, for several lenses; < 1e-6 normalised required (we see ~1e-15).
 #include <gtest/gtest.h>

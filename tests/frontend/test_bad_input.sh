@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Bad-input matrix (issue 8) at the tools' level: each bad input gives a clear error naming what
 # is wrong, a non-zero exit, no crash (no exit >= 128), and never a partial file in place of a
 # good one. (Covered elsewhere: strides and dimensions in tests/unit/test_image.c and

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The cyl tool as a user meets it: exit codes, errors that name what is wrong, no partial
 # output in place of a good file, a clean stop on SIGINT that keeps every complete record.
 # Prints GoogleTest-style lines for scripts/run-tests.sh.

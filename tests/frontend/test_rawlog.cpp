@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Raw frame log and observation log: round trips, the .part/rename guarantee, every malformation.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // libFuzzer: the calibration file reader (OpenCV and ROS YAML). Any bytes must load or end in
 // a cylfe::Error; any other exception (cv::Exception, std::...) escaping is a finding.
 #include <cstdint>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libFuzzer: frame -> blobs -> observations over random formats, dimensions, strides, regions
  * of interest, steps and merge rules (within the documented limits), with invariants checked:
  * every blob's runs add up to its area and point back to it, counts stay within capacity,

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """libFuzzer target (through atheris) for the observation-log reader, cylslam.obslog.
 
 Every input is parsed twice, strict and with skip_bad=True. The reader's contract

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // libFuzzer: the raw frame log reader. Any bytes must end in records or a cylfe::Error.
 #include <cstdint>
 #include <cstdio>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libFuzzer: the colour table loader. Any input must give a status, never a crash; a
  * table that loads must save back to the same bytes.
  * The loader checks the CRC-32 (the last 4 bytes, over everything before them) before the

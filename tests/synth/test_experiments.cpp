@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Reduced versions of the paper's consistency experiments (make validate runs the full ones):
 // Tables 1-3 (local estimator against measured frame-to-frame variance), Tables 6-7 (range and
 // bearing errors against their sigmas with calibration errors drawn per run), the blob-centroid

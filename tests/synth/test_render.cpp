@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The synthetic camera: determinism, geometry against analytic projection, lens model against
 // OpenCV, YUYV chroma subsampling, odometry noise statistics, the Source event order, scene files
 // and the raw log round trip.

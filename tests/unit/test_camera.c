@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Camera model: distortion Jacobian, undistortion round trip and its Jacobians against
  * central differences, camera validation. */
 #include <stdarg.h>

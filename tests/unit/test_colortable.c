@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Colour table: classification rule, training, serialisation and every corruption. */
 #include <stdarg.h>
 #include <stddef.h>

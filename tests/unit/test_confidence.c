@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Landmark confidence (paper eqs. 7-8) and the border rule, hand-computed values. */
 #include <stdarg.h>
 #include <stddef.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Image views: byte layouts of each format written by hand, strides, size checks. */
 #include <stdarg.h>
 #include <stddef.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Centroid variance estimators (paper eqs. 4-6): hand-computed small blobs, and all three
  * estimators against a brute-force evaluation on a pixel grid over thousands of random blobs. */
 #include <stdarg.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* cyl_observe: blobs to observations, on hand-made segmentations of rendered landmarks and end
  * to end through cyl_segment on a synthetic frame. */
 #include <stdarg.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Range/bearing geometry and its uncertainty: analytic Jacobians against central differences,
  * first-order covariance against Monte Carlo over all 15 inputs, horizon handling, the error
  * budget, and the paper's Tables 6 and 8 reproduced with its Table 4/5 camera. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* Segmentation: hand-derived cases and a brute-force reference on random frames. */
 #include <stdarg.h>
 #include <stddef.h>

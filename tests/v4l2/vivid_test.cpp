@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Runs inside a qemu VM with the kernel's vivid driver (scripts/vivid-test.sh): the frontend's
 // V4L2 source against a real driver. Prints GoogleTest-style lines and a summary.
 //

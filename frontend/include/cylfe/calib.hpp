@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cylfe::calib -- the calibration tools' library (docs/calibration.md):
 //   * chessboard detection (cv::findChessboardCorners + cv::cornerSubPix),
 //   * intrinsic calibration: closed-form start (cv::initCameraMatrix2D + per-view PnP), Ceres

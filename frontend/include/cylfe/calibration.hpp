@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cylfe: camera calibration files -> the C camera description (cyl_camera, libcyl/camera.h).
 //
 // Two formats, detected from the content:

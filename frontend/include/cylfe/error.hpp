@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cylfe: the C++ frontend on libcyl. Errors are exceptions carrying a message that names the
 // file, line, field or device at fault; the tools turn them into a message and an exit code.
 #pragma once

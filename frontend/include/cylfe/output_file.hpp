@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Where an output file is written so that only a regular file is ever replaced.
 //
 // A tool's output (an observation log, a raw frame log, a colour table, a calibration file) is

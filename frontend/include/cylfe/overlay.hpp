@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The overlay view: classified pixels, blob boxes, range/bearing text and the 95% uncertainty
 // ellipse of each landmark's position, drawn on the frame (OpenCV BGR image).
 #pragma once

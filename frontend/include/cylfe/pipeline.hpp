@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Source -> libcyl -> observations: the detector and the observation log (docs/formats.md).
 #pragma once
 #include <cstdint>

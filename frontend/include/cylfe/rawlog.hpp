@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Raw frame log (*.cylraw, docs/formats.md): record any source, replay it later.
 #pragma once
 #include <cstdint>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Frame sources behind one interface: V4L2 devices, raw logs, image/video files, the synthetic scene.
 #pragma once
 #include <cstdint>

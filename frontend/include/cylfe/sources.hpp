@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Sources other than V4L2 (v4l2.hpp) and the synthetic scene (synth.hpp), and a factory
 // that opens any source from a command-line spec.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cylfe::synth -- a synthetic camera with ground truth (docs/synthetic.md).
 //
 // A flat floor inside a room of walls; vertical cylinders (the landmarks), boxes, thin poles

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Live capture from a V4L2 device: mmap streaming, poll with timeout, driver timestamps and
 // sequence numbers (dropped frames counted from sequence gaps), controls.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cylfe::calib -- chessboard detection and the intrinsic calibration (calib.hpp).
 #include "cylfe/calib.hpp"
 #include "solver.hpp"

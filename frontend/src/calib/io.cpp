@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cylfe::calib -- files: atomic writes, the calibration YAML writers, colour tables, frames.
 #include "cylfe/calib.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cylfe::calib -- the robot mount's extrinsics from a chessboard lying on the floor (calib.hpp).
 #include "cylfe/calib.hpp"
 #include "solver.hpp"

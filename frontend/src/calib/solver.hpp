@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal to frontend/src/calib/: the Ceres settings every calibration fit uses (tight
 // tolerances, single thread, silent), so that the fits converge to the same precision.
 #pragma once

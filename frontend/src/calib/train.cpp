@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // cylfe::calib -- colour-table training helpers (calib.hpp).
 #include "cylfe/calib.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal to frontend/src/synth/: corner points of the scene's rectangular objects (boxes, floor
 // patches), shared by the renderer's screen boxes and the experiments' projections.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Robot trajectory, odometry with a documented noise model, and the SyntheticSource.
 #include "cylfe/synth.hpp"
 #include "cylfe/error.hpp"

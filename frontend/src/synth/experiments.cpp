@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The paper's consistency experiments on rendered frames (docs/synthetic.md).
 #include "cylfe/synth_experiments.hpp"
 #include "cylfe/error.hpp"

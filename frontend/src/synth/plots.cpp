@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // PNG plots of the experiments, drawn with OpenCV (no Python needed).
 #include "cylfe/synth_experiments.hpp"
 #include "cylfe/error.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Helpers internal to frontend/src/synth/: seeded random streams (splitmix64, and a
 // standard-normal stream by Box-Muller on its outputs; deterministic for a seed) and angle
 // wrapping.

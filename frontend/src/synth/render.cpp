@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Ray-casting renderer of the synthetic scene (docs/synthetic.md). Own lens and mounting code:
 // nothing here calls libcyl's camera model.
 #include "cylfe/synth.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Scenes: the built-in default, scene files (cv::FileStorage YAML/JSON), the libcyl camera.
 #include "cylfe/synth.hpp"
 #include "cylfe/error.hpp"

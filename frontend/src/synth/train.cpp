@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Colour table for a synthetic scene: trained by libcyl's cyl_colortable_train on rendered
 // frames of the scene's landmark colours (paper section 3.3: operator regions over several
 // images and illuminations; here the region is the inner part of a landmark's projection).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- camera description: pinhole intrinsics with Brown-Conrady lens
  * distortion, the camera's mounting on the robot, and the uncertainty of both
  * (paper section 2.3, Tables 4 and 5).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- colour classes and the colour lookup table (paper section 3.2-3.3).
  *
  * A pixel (Y, U, V) belongs to the set of classes whose bits are set in

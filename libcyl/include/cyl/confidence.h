@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- landmark confidence (paper section 2.2, eqs. 7-8).
  *
  *   c = r(w / w_est) * r(h / h_est),   r(x) = x for x <= 1, 1/x for x > 1

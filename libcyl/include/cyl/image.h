@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- image views: a description of caller-owned YUV pixel memory.
  *
  * libcyl never copies or owns pixels. A cyl_image says where the planes are,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- variance of a blob's centroid from a single frame (paper section
  * 2.1, eqs. 3-6; paper-model.md "Centroid variance from one frame").
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- from a frame's blobs to landmark observations with uncertainty
  * (the whole of paper section 2 in one call; docs/uncertainty.md).
  *

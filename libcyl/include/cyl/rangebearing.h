@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- from a pixel to the landmark's range and bearing in the robot
  * frame, with the full first-order covariance and the error budget of the
  * paper's Tables 8 and 9 (paper section 2.3.2; docs/uncertainty.md).

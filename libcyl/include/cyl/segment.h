@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- run-length encoding and blobs (paper section 3.2, CMVision-style).
  *
  * cyl_segment() does, in one pass over the frame: classification through a

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- status codes shared by every call.
  *
  * Every libcyl function that can fail returns a cyl_status. Zero is success,
