@@ -12,9 +12,10 @@
   (GTSAM's tangent convention of the marginals). ANEES = mean NEES / dimension, so a consistent
   estimator gives 1; its two-sided 95 % bounds are chi2_{N d}(0.025)/(N d) and
   chi2_{N d}(0.975)/(N d) for N estimates of dimension d (Wilson-Hilferty approximation).
-- Association: each used observation gets a true label: the true landmark of its class nearest
-  to its true world position (true pose (+) measured range/bearing), or "clutter" if none lies
-  within max(0.5 m, 4 sigma) of it. A one-to-one matching of estimated to true landmarks
+- Association: each used observation gets a true label: the true landmark of its class whose
+  (range, bearing) from the true pose is nearest the measured one in the observation's own
+  covariance (Mahalanobis), or "clutter" if that distance is beyond the 99.99% gate of 2 dof and
+  the landmark is more than 0.5 m from the observation's true world position. A one-to-one matching of estimated to true landmarks
   maximising the number of agreeing observations (Hungarian on the contingency table) defines
   which estimated landmark *is* which true landmark; association errors = used observations not
   on a matched (estimated, true) pair: wrong landmark, a landmark split in two, clutter used.
@@ -27,7 +28,7 @@ import math
 import numpy as np
 
 from .backend import hungarian
-from .data import between, rb_to_world
+from .data import between, rb_to_world, wrap
 
 Z975 = 1.959963984540054
 
@@ -100,14 +101,25 @@ def truth_labels(ds, res):
         if tp is None or o.cls not in by_cls:
             out.append(None)
             continue
-        w = rb_to_world(tp, o.range_m, o.bearing_rad)
-        best, bd = None, float("inf")
+        # The landmark the observation is most likely of: smallest Mahalanobis distance between the
+        # measured (range, bearing) and the one predicted from the true pose, with the
+        # observation's covariance. (Nearest in the plane was wrong far away, where a range sigma
+        # of 0.6 m puts the point between two landmarks while the bearing, 8 mrad, is unambiguous.)
+        best, bd2 = None, float("inf")
+        try:
+            inv = np.linalg.inv(np.asarray(o.cov, float))
+        except np.linalg.LinAlgError:
+            inv = None
         for k, x, y in by_cls[o.cls]:
-            dd = math.hypot(x - w[0], y - w[1])
-            if dd < bd:
-                best, bd = k, dd
-        sig = math.sqrt(max(o.cov[0, 0], (o.range_m ** 2) * o.cov[1, 1]))
-        out.append(best if bd <= max(0.5, 4 * sig) else None)
+            dx, dy = x - tp[0], y - tp[1]
+            nu = np.array([o.range_m - math.hypot(dx, dy), wrap(o.bearing_rad - (math.atan2(dy, dx) - tp[2]))])
+            d2 = float(nu @ inv @ nu) if inv is not None else float("inf")
+            if d2 < bd2:
+                best, bd2 = k, d2
+        # accepted within the 99.99% chi-square gate of 2 dof, or within 0.5 m in the plane
+        w = rb_to_world(tp, o.range_m, o.bearing_rad)
+        near = best is not None and math.hypot(tl[best][0] - w[0], tl[best][1] - w[1]) <= 0.5
+        out.append(best if (bd2 <= 18.42 or near) else None)
     return out
 
 

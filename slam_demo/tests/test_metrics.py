@@ -63,3 +63,23 @@ def test_anees_is_one_for_a_consistent_monte_carlo():
     assert lo < a < hi
     a2, _ = metrics.anees(errs, [C / 4] * len(errs))
     assert a2 == pytest.approx(4 * a)
+
+
+def test_truth_label_follows_the_bearing_far_away():
+    # Seen from the origin: landmark 2 at 6.18 m, landmark 4 at 3.07 m, 0.16 rad apart. A far
+    # observation of landmark 2 whose range came out 1.63 m short (2.7 sigma, sigma_r 0.61 m)
+    # lies in the plane nearer landmark 4; its bearing (sigma 7.6 mrad) says landmark 2.
+    # (A case from the synthetic drive, seed 2, step 701.)
+    from types import SimpleNamespace
+    from cylslam.data import Dataset, Obs, Step
+    from cylslam.metrics import truth_labels
+    lm2 = (6.177 * np.cos(0.0619), 6.177 * np.sin(0.0619), "orange")
+    lm4 = (3.070 * np.cos(-0.0969), 3.070 * np.sin(-0.0969), "orange")
+    o = Obs(cls="orange", range_m=4.550, bearing_rad=0.0685,
+            cov=np.array([[0.613 ** 2, 0.0], [0.0, 0.0076 ** 2]]))
+    clutter = Obs(cls="orange", range_m=4.550, bearing_rad=0.30,
+                  cov=np.array([[0.613 ** 2, 0.0], [0.0, 0.0076 ** 2]]))
+    ds = Dataset(name="t", steps=[Step(t=0.0, seq=0, obs=[o, clutter], truth=np.zeros(3))],
+                 truth_landmarks={2: lm2, 4: lm4})
+    res = SimpleNamespace(assoc=[(0, o, 0), (0, clutter, 1)])
+    assert truth_labels(ds, res) == [2, None]
