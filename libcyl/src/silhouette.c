@@ -44,7 +44,10 @@ cyl_status cyl_silhouette_bias_at(const cyl_camera *cam, double x_m, double y_m,
         return CYL_ERR_ARG;
     s = cyl_camera_check(cam);
     if (s != CYL_OK) return s;
-    r = 0.5 * size->diameter_m;
+    /* the radius of the polygon whose area is the circle's (an inscribed polygon of 48 points is
+     * 0.3% smaller) */
+    r = 0.5 * size->diameter_m *
+        sqrt(6.283185307179586 / (CYL_SILHOUETTE_POINTS * sin(6.283185307179586 / CYL_SILHOUETTE_POINTS)));
     for (i = 0; i < CYL_SILHOUETTE_POINTS; i++) {
         const double a = 6.283185307179586 * (double)i / CYL_SILHOUETTE_POINTS;
         const double px = x_m + r * cos(a), py = y_m + r * sin(a);

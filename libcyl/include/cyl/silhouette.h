@@ -29,7 +29,8 @@
 extern "C" {
 #endif
 
-/* Points per circle of the hull (top and bottom): the hull's area is within 0.3% of the true one. */
+/* Points per circle of the hull (top and bottom); 48 keep the offset within 0.03 px of ray casting
+ * (tests/unit/test_silhouette.c; 32 did not: 0.07 px); stack ~3.4 KB on x86-64. */
 #define CYL_SILHOUETTE_POINTS 48
 
 typedef struct cyl_silhouette_bias {
