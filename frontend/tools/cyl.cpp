@@ -145,7 +145,16 @@ Args parse(int argc, char **argv)
             a.var_floor_px2 = parse_double(s, val(s));
             if (a.var_floor_px2 < 0) usage_error("--centroid-var-floor: must be >= 0 px^2");
         }
-        else if (s == "--overlay") a.overlay = val(s);
+        else if (s == "--overlay") {
+            a.overlay = val(s);
+            const std::string &o = a.overlay;
+            size_t slash = o.find_last_of('/'), dot = o.find_last_of('.');
+            bool has_ext = dot != std::string::npos && (slash == std::string::npos || dot > slash) && dot + 1 < o.size() &&
+                           dot > (slash == std::string::npos ? 0 : slash + 1);
+            if (has_ext && o.compare(dot, std::string::npos, ".avi") != 0)
+                usage_error("--overlay " + o + ": the video is written as MJPG in an .avi file; give FILE.avi, or a "
+                            "folder for one PNG per frame");
+        }
         else if (s == "--show") a.show = true;
         else if (s == "--max-frames") a.max_frames = parse_u64(s, val(s));
         else if (s == "--realtime") a.src.realtime = true;
@@ -230,6 +239,12 @@ int cmd_detect(const Args &a)
     cyl_noise_estimator est;
     if (!parse_model(a.model, &model)) usage_error("--model: exact or paper, got '" + a.model + "'");
     if (!parse_estimator(a.estimator, &est)) usage_error("--estimator: image, local, column or uniform, got '" + a.estimator + "'");
+    if (a.show) {  // without a display Qt aborts the process (exit 134) inside cv::imshow
+        const char *d = std::getenv("DISPLAY"), *w = std::getenv("WAYLAND_DISPLAY");
+        if ((!d || !*d) && (!w || !*w))
+            usage_error("--show needs a display (DISPLAY and WAYLAND_DISPLAY are unset); write the overlay "
+                        "with --overlay DIR|FILE.avi instead");
+    }
     bool synthetic = is_synthetic(a.source);
     std::string table_path = a.table.empty() && synthetic ? "calib_data/synthetic.cylt" : a.table;
     if (table_path.empty()) usage_error("detect: --table is required");
@@ -285,6 +300,9 @@ int cmd_detect(const Args &a)
                             cv::Size((int)src->info().width, (int)src->info().height)))
                 throw Error(o + ": cannot open video for writing");
         } else {
+            struct stat st;
+            if (::stat(o.c_str(), &st) == 0 && !S_ISDIR(st.st_mode))
+                throw Error(o + ": --overlay names an existing file that is not a folder");
             if (mkdir(o.c_str(), 0777) != 0 && errno != EEXIST) throw Error(o + ": cannot create folder: " + std::strerror(errno));
             overlay_dir = true;
         }
@@ -293,7 +311,11 @@ int cmd_detect(const Args &a)
     SourceEvent ev;
     uint64_t frames = 0, observations = 0, truncated = 0;
     double t0 = now_s();
-    while (!g_interrupted && (a.max_frames == 0 || frames < a.max_frames) && src->next(ev)) {
+    // --max-frames N: the records that follow the N-th frame (its odometry and truth) are kept; the
+    // loop stops at the next frame. A live camera stops at the N-th frame itself.
+    const bool live = dynamic_cast<V4L2Source *>(src.get()) != nullptr;
+    while (!g_interrupted && !(live && a.max_frames && frames >= a.max_frames) && src->next(ev)) {
+        if (ev.kind == RecordType::Frame && a.max_frames && frames >= a.max_frames) break;
         switch (ev.kind) {
         case RecordType::Frame: {
             const std::vector<cyl_observation> &obs = det.process(ev.image);
@@ -352,7 +374,11 @@ int cmd_record(const Args &a)
     SourceEvent ev;
     uint64_t frames = 0;
     double t0 = now_s();
-    while (!g_interrupted && (a.max_frames == 0 || frames < a.max_frames) && src->next(ev)) {
+    // --max-frames N: the records that follow the N-th frame (its odometry and truth) are kept; the
+    // loop stops at the next frame. A live camera stops at the N-th frame itself.
+    const bool live = dynamic_cast<V4L2Source *>(src.get()) != nullptr;
+    while (!g_interrupted && !(live && a.max_frames && frames >= a.max_frames) && src->next(ev)) {
+        if (ev.kind == RecordType::Frame && a.max_frames && frames >= a.max_frames) break;
         switch (ev.kind) {
         case RecordType::Frame:
             w.frame(ev.header.seq, ev.header.t_ns, ev.data, ev.header.size, ev.header.flags);

@@ -2,7 +2,8 @@
 """Command line: python -m cylslam {run,synth,mrclam,victoria,excerpt} --help
 
 Exit codes: 0 success; 1 an acceptance check asked for with --check failed; 2 usage error;
-3 input error (missing file, malformed log: the message names file and line).
+3 input error (missing file, malformed log: the message names file and line); 4 the outputs
+cannot be written (the message names the path).
 The last line printed on stdout by run / mrclam / victoria is one JSON object.
 """
 from __future__ import annotations
@@ -17,7 +18,7 @@ import time
 
 import numpy as np
 
-EXIT_OK, EXIT_CHECK, EXIT_USAGE, EXIT_INPUT = 0, 1, 2, 3
+EXIT_OK, EXIT_CHECK, EXIT_USAGE, EXIT_INPUT, EXIT_OUTPUT = 0, 1, 2, 3, 4
 FIXED_GRID = (0.25, 0.5, 1.0, 2.0, 4.0)
 
 
@@ -312,11 +313,19 @@ def cmd_run(args):
     for n in ds.notes:
         print(f"note: {n}")
     out = args.out or os.path.join("out", "slam", os.path.splitext(os.path.basename(args.log))[0])
+    try:   # before the run: a folder that cannot be made fails now, not after the work
+        os.makedirs(out, exist_ok=True)
+    except OSError as e:
+        print(f"cylslam: error: {out}: cannot create the output folder: {e.strerror}", file=sys.stderr)
+        return EXIT_OUTPUT
     try:
         s = process(ds, args, "slam", out)
     except ValueError as e:
         print(f"cylslam: error: {e}", file=sys.stderr)
         return EXIT_INPUT
+    except OSError as e:
+        print(f"cylslam: error: {e.filename or out}: cannot write the outputs: {e.strerror}", file=sys.stderr)
+        return EXIT_OUTPUT
     s["skipped_lines"] = getattr(ds, "n_skipped", 0)
     print_summary(s)
     rc = EXIT_OK
@@ -424,7 +433,8 @@ def cmd_excerpt(args):
 def build_parser():
     ap = argparse.ArgumentParser(prog="python -m cylslam",
                                  description="Landmark SLAM (GTSAM) with per-observation covariance. "
-                                             "Exit codes: 0 ok, 1 check failed, 2 usage, 3 input error.")
+                                             "Exit codes: 0 ok, 1 check failed, 2 usage, 3 input error, "
+                                             "4 cannot write the outputs.")
     sub = ap.add_subparsers(dest="cmd", required=True)
 
     sp = sub.add_parser("run", help="SLAM on an observation log (docs/formats.md)",

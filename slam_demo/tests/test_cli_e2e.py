@@ -99,3 +99,11 @@ def test_fixed_covariance_that_maps_nothing_is_reported_failed(monkeypatch, caps
     cli.print_summary(s)
     assert "FAILED" in capsys.readouterr().out
     assert not any("fixed-cov" in f for f in cli.check_synthetic(s))
+
+
+def test_cli_unwritable_output_is_a_clear_error():
+    # /proc refuses new folders: exit 4 with the path named, no traceback, before any work
+    r = _cli("run", SHORT, "--no-plot", "--fixed-cov", "none", "--out", "/proc/nope/x")
+    assert r.returncode == 4, r.stderr
+    assert "/proc/nope/x: cannot create the output folder" in r.stderr
+    assert "Traceback" not in r.stderr

@@ -32,6 +32,17 @@ chmod +x "$T/detect"
 
 : > "$T/empty"
 check empty_table 1 "empty: table file truncated" -- "$T/detect" "$T/s.cylraw" "$T/empty" $CALIB
+# --show without a display: a clear usage error, not Qt's abort (exit 134), and no .part left
+check show_without_display 2 "--show needs a display" -- env -u DISPLAY -u WAYLAND_DISPLAY "$CYL" detect "$T/s.cylraw" \
+  --table $TABLE --calib $CALIB --out "$T/good.jsonl" --show --quiet
+[ ! -e "$T/good.jsonl.part" ] || { failed=$((failed + 1)); echo "  a .part file was left"; echo "[  FAILED  ] bad_input.show_without_display_part"; }
+# --overlay with a container other than .avi: a usage error, and no folder named x.mp4 made
+check overlay_mp4 2 "x.mp4: the video is written as MJPG in an .avi" -- "$CYL" detect "$T/s.cylraw" --table $TABLE \
+  --calib $CALIB --out "$T/good.jsonl" --overlay "$T/x.mp4" --quiet
+[ ! -e "$T/x.mp4" ] || { failed=$((failed + 1)); echo "  a folder x.mp4 was made"; echo "[  FAILED  ] bad_input.overlay_mp4_no_folder"; }
+: > "$T/afile"
+check overlay_onto_file 1 "afile: --overlay names an existing file that is not a folder" -- "$CYL" detect "$T/s.cylraw" \
+  --table $TABLE --calib $CALIB --out "$T/good.jsonl" --overlay "$T/afile" --quiet
 check empty_calib 1 "empty: not a calibration file" -- "$T/detect" "$T/s.cylraw" $TABLE "$T/empty"
 : > "$T/empty.cylraw"
 check empty_raw_log 1 "empty.cylraw: not a libcyl raw frame log" -- "$T/detect" "$T/empty.cylraw" $TABLE $CALIB

@@ -141,6 +141,23 @@ grep -q "^rendering: 100%" "$T/p.err" || fail "no progress line from cyl-render:
 grep -q "^detecting: 100%" "$T/p.err" || fail "no progress line from cyl detect: $(head -c 300 "$T/p.err")"
 finish
 
+# --max-frames N keeps the N-th frame's odometry and truth (they follow the frame in the source)
+start max_frames_keeps_last_odometry
+"$CYL" detect synthetic:3 --max-frames 5 --out "$T/mf.jsonl" --quiet 2>"$T/err" || fail "detect failed: $(head -c 300 "$T/err")"
+counts=$(python3 -c "
+import json, sys
+t = [json.loads(l)['type'] for l in open(sys.argv[1])]
+print(t.count('frame'), t.count('odom'), t.count('truth_pose'))" "$T/mf.jsonl")
+[ "$counts" = "5 5 5" ] || fail "frames, odom, truth_pose: $counts (expected 5 5 5)"
+"$CYL" record synthetic:3 --max-frames 4 --out "$T/mf.cylraw" --quiet 2>"$T/err" || fail "record failed"
+"$CYL" detect "$T/mf.cylraw" --table $TABLE --calib $CALIB --out "$T/mf2.jsonl" --quiet 2>"$T/err" || fail "detect on the recording failed"
+counts=$(python3 -c "
+import json, sys
+t = [json.loads(l)['type'] for l in open(sys.argv[1])]
+print(t.count('frame'), t.count('odom'), t.count('truth_pose'))" "$T/mf2.jsonl")
+[ "$counts" = "4 4 4" ] || fail "recorded with --max-frames 4: frames, odom, truth_pose $counts (expected 4 4 4)"
+finish
+
 echo "[==========] $((passed + failed)) tests ran."
 echo "[  PASSED  ] $passed tests."
 [ $failed -eq 0 ] || echo "[  FAILED  ] $failed tests."
