@@ -312,7 +312,8 @@ def cmd_run(args):
         return EXIT_INPUT
     for n in ds.notes:
         print(f"note: {n}")
-    out = args.out or os.path.join("out", "slam", os.path.splitext(os.path.basename(args.log))[0])
+    out = args.out or os.path.join("out", "slam", "stdin" if args.log == "-" else
+                                   os.path.splitext(os.path.basename(args.log))[0])
     try:   # before the run: a folder that cannot be made fails now, not after the work
         os.makedirs(out, exist_ok=True)
     except OSError as e:
@@ -440,7 +441,8 @@ def build_parser():
     sp = sub.add_parser("run", help="SLAM on an observation log (docs/formats.md)",
                         description="Run the back end on a cyl-observations JSON Lines log; with "
                                     "truth lines, print metrics. Last stdout line: JSON.")
-    sp.add_argument("log", help="observation log (.jsonl)")
+    sp.add_argument("log", help="observation log (.jsonl); - reads standard input to its end, e.g. behind "
+                    "`cyl detect SOURCE --out -`")
     sp.add_argument("--skip-bad", action="store_true",
                     help="skip malformed lines (counted and listed) instead of stopping at the first")
     sp.add_argument("--check", action="store_true",

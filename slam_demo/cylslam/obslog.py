@@ -223,7 +223,12 @@ class _Builder:
 
 
 def read_obslog(path, skip_bad=False) -> Dataset:
-    """Read an observation log into a Dataset. Raises ObsLogError (strict) or skips bad lines."""
+    """Read an observation log into a Dataset. Raises ObsLogError (strict) or skips bad lines.
+    path "-" reads standard input to its end (e.g. behind `cyl detect ... --out -`); messages then
+    name it "<stdin>"."""
+    if path == "-":
+        import sys
+        return parse_obslog(sys.stdin.buffer.read(), "<stdin>", skip_bad)
     try:
         with open(path, "rb") as fh:
             raw = fh.read()

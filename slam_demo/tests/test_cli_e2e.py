@@ -107,3 +107,36 @@ def test_cli_unwritable_output_is_a_clear_error():
     assert r.returncode == 4, r.stderr
     assert "/proc/nope/x: cannot create the output folder" in r.stderr
     assert "Traceback" not in r.stderr
+
+
+def test_cli_run_reads_stdin(tmp_path):
+    # `run -` reads the log from standard input (as behind `cyl detect ... --out -`)
+    with open(SHORT, "rb") as fh:
+        r = subprocess.run([sys.executable, "-m", "cylslam", "run", "-", "--no-plot", "--fixed-cov", "none",
+                            "--out", str(tmp_path)], stdin=fh, capture_output=True, text=True, env=ENV, timeout=120)
+    assert r.returncode == 0, r.stderr
+    last = json.loads(r.stdout.strip().splitlines()[-1])
+    ref = json.loads(_cli("run", SHORT, "--no-plot", "--fixed-cov", "none", "--out",
+                          str(tmp_path / "f")).stdout.strip().splitlines()[-1])
+    assert last["ate_m"] == ref["ate_m"] and last["association_errors"] == ref["association_errors"]
+    r = subprocess.run([sys.executable, "-m", "cylslam", "run", "-", "--no-plot"], input="{\"type\":",
+                       capture_output=True, text=True, env=ENV, timeout=60)
+    assert r.returncode == 3 and "<stdin>:1" in r.stderr
+
+
+def test_cli_run_behind_cyl_detect_pipe(tmp_path):
+    # the frontend's stdout straight into the back end: cyl detect ... --out - | cylslam run -
+    cyl = os.path.join(os.path.dirname(os.path.dirname(HERE)), "build", "cyl")
+    if not os.path.exists(cyl):
+        pytest.skip("build/cyl not built (make test builds it first)")
+    det = subprocess.Popen([cyl, "detect", "synthetic:3", "--max-frames", "60", "--size", "orange=0.10,0.30",
+                            "--size", "green=0.10,0.30", "--out", "-", "--quiet"],
+                           stdout=subprocess.PIPE, cwd=os.path.dirname(os.path.dirname(HERE)))
+    r = subprocess.run([sys.executable, "-m", "cylslam", "run", "-", "--no-plot", "--fixed-cov", "none",
+                        "--out", str(tmp_path)], stdin=det.stdout, capture_output=True, text=True, env=ENV,
+                       timeout=300)
+    det.stdout.close()
+    assert det.wait(timeout=60) == 0
+    assert r.returncode == 0, r.stderr
+    assert "60 poses" in r.stdout
+    assert json.loads(r.stdout.strip().splitlines()[-1])["ate_m"] < 0.05
