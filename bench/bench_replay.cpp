@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// End-to-end replay benchmark (issue 5): a recorded 640x480 YUYV log through `cyl detect`
+// End-to-end replay benchmark: a recorded 640x480 YUYV log through `cyl detect`
 // (read, segment, observe, write the JSON Lines log), as a separate process, timed from outside;
 // peak memory (ru_maxrss) for a 1,000- and a 10,000-frame log must be the same.
 //

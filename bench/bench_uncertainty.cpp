@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Uncertainty benchmark (issue 3): time of noise estimation + camera model (cyl_observe with the
+// Uncertainty benchmark: time of noise estimation + camera model (cyl_observe with the
 // local estimator: centroid variance, undistortion, range/bearing, covariance, confidence) for
 // all blobs of a frame, against the time to segment that frame (cyl_segment). Same synthetic
 // frames as bench_segment. Prints a table line and, last, a JSON fragment

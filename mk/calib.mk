@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-3-Clause
-# Calibration tools (issue 6, docs/calibration.md):
+# Calibration tools (docs/calibration.md):
 #   build/cyl-calibrate   intrinsics (Ceres, full covariance) and the robot mount's extrinsics
 #   build/cyl-train       colour-table training (command line and interactive window)
 #   make calib-check      our calibration vs cv::calibrateCamera on OpenCV's sample images, the

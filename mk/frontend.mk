@@ -54,7 +54,7 @@ $(BUILD)/tests/fe_%: tests/frontend/%.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
 TEST_EXTRA += $(FE_TEST_BINS)
 TEST_EXTRA_BINS += $(FE_TEST_BINS)
 
-# ---- make bench: end-to-end replay (issue 5) ------------------------------------------------
+# ---- make bench: end-to-end replay ------------------------------------------------
 $(BUILD)/bench_replay: bench/bench_replay.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
 	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) -O2 $< -o $@ $(FRONTEND_A) $(FE_SYNTH_OBJS) $(LIBCYL_A) $(CV_LIBS) -lm
 
@@ -66,7 +66,7 @@ TEST_EXTRA += $(BUILD)/cyl-train $(BUILD)/cyl-calibrate
 TEST_EXTRA_BINS += tests/frontend/test_output_safety.sh:$(BUILD)
 
 # ---- make soak: 10,000 synthetic frames in one process; peak RSS at the end must equal its
-# peak at frame 1,000 (issue 8; scripts/soak.sh) ----------------------------------------------
+# peak at frame 1,000 (scripts/soak.sh) ----------------------------------------------
 soak: $(BUILD)/cyl
 	@BUILD=$(BUILD) scripts/soak.sh
 .PHONY: soak

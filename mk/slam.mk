@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-3-Clause
-# slam_demo (cylslam): the Python SLAM back end (issue 7). Included by the top Makefile.
+# slam_demo (cylslam): the Python SLAM back end. Included by the top Makefile.
 #   make slam-venv     the project-local venv .venv/ (gtsam==4.3.0, numpy, matplotlib, pytest)
 #   make slam-test     the slam_demo pytest suite (also part of `make test`)
 #   make slam-synth    synthetic log -> SLAM -> plots, metrics, acceptance check (out/slam/synth)

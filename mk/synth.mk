@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
-# The synthetic camera with ground truth and the paper's consistency experiments (issue 4;
-# docs/synthetic.md).
+# The synthetic camera with ground truth and the paper's consistency experiments
+# (docs/synthetic.md).
 #   make render      render the default drive (1000 frames) into build/drive.cylraw
 #   make validate    Tables 1-3, 6-7 and the confidence check; plots in build/validate/;
 #                    last line a JSON summary

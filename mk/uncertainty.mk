@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-3-Clause
-# libcyl uncertainty model (issue 3): C++ calibration loader, the paper tool, OpenCV tests.
+# libcyl uncertainty model: C++ calibration loader, the paper tool, OpenCV tests.
 #   make paper       the paper's Tables 6, 8, 9 beside ours; last line JSON
 # Test programs added to `make test`: build/tests/test_undistort_cv, build/tests/test_calibration.
 
@@ -26,7 +26,7 @@ $(BUILD)/tests/test_calibration: tests/cv/test_calibration.cpp $(UNC_FE_OBJ) lib
 TEST_EXTRA += $(BUILD)/tests/test_undistort_cv $(BUILD)/tests/test_calibration
 TEST_EXTRA_BINS += $(BUILD)/tests/test_undistort_cv $(BUILD)/tests/test_calibration
 
-# make bench-uncertainty: cyl_observe time per frame vs cyl_segment (issue 3: <= 10%). Its last
+# make bench-uncertainty: cyl_observe time per frame vs cyl_segment (target <= 10%). Its last
 # line is a JSON fragment meant for scripts/bench.sh's BENCH_EXTRA_JSON.
 $(BUILD)/bench_uncertainty: bench/bench_uncertainty.cpp bench/bench_frames.hpp tests/common/synth_frames.c tests/common/rng.c lib
 	@mkdir -p $(dir $@)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: BSD-3-Clause
-# make ci-hardening (issue 8), run by .ci/run after `make test`: the whole suite under
+# make ci-hardening, run by .ci/run after `make test`: the whole suite under
 # AddressSanitizer + UndefinedBehaviorSanitizer, the firmware build and the second architecture,
 # 60 s of fuzzing per target, static analysis, and the 10,000-frame soak. The steps run one after
 # another (the CI machine has 2 cores). Every step runs even when an earlier one fails, so one CI

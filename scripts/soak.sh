@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: BSD-3-Clause
-# make soak (issue 8): 10,000 synthetic frames through the frontend (render + detect + log, one
+# make soak: 10,000 synthetic frames through the frontend (render + detect + log, one
 # `cyl detect` process). The process's peak resident memory (VmHWM) is read when its log reaches
 # frame 1,000 and again at the end: the peak of the 10,000-frame run
 # must equal the peak of its first 1,000 frames, i.e. nothing grows per frame. Measured in one

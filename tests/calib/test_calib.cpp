@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The calibration tools (issue 6): intrinsics against cv::calibrateCamera on OpenCV's sample
+// The calibration tools: intrinsics against cv::calibrateCamera on OpenCV's sample
 // images, the reported sigmas against a Monte Carlo, the mount extrinsics on synthetic floor
 // renders, the file writers, colour-table training, and the tools' handling of bad input.
 #include <gtest/gtest.h>

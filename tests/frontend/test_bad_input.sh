@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: BSD-3-Clause
-# Bad-input matrix (issue 8) at the tools' level: each bad input gives a clear error naming what
+# Bad-input matrix at the tools' level: each bad input gives a clear error naming what
 # is wrong, a non-zero exit, no crash (no exit >= 128), and never a partial file in place of a
 # good one. (Covered elsewhere: strides and dimensions in tests/unit/test_image.c and
 # test_segment.c, corrupt tables in test_colortable.c, corrupt logs in test_rawlog.cpp and the

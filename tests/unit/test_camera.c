@@ -173,7 +173,7 @@ static void test_check(void **st)
     assert_true(c.intr_cov[0][0] == 0.0);
 }
 
-/* Bad-input matrix (issue 8): NaN, infinite or negative sigmas and covariances are refused. */
+/* Bad-input matrix: NaN, infinite or negative sigmas and covariances are refused. */
 static void test_bad_sigmas_refused(void **st)
 {
     cyl_camera c;

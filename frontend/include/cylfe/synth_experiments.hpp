@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The paper's consistency experiments on the synthetic camera (issue 4; docs/synthetic.md):
+// The paper's consistency experiments on the synthetic camera (docs/synthetic.md):
 // Tables 1-3 (centroid variance estimators against frame-to-frame variance), Tables 6-7 (range
 // and bearing errors against their sigmas with calibration errors drawn per run), the
 // landmark-confidence check, and the colour table trained on rendered frames.
