@@ -110,6 +110,24 @@ void write_text(const std::string &path, const std::string &s)
     std::fclose(f);
 }
 
+// One line per pixel-noise-only observation: its errors, the centroid, the modelled silhouette bias
+// and the variances (the data behind the silhouette term's choice, docs/uncertainty.md).
+std::string pixel_only_csv(const std::vector<RbSample> &rbp)
+{
+    std::string pcsv = "run,axis_range_m,axis_bearing_rad,range_m,bearing_rad,cov_rr,cov_rb,cov_bb,du_centroid_px,"
+                       "dv_centroid_px,du_point_px,dv_point_px,bias_u_px,bias_v_px,var_centroid_u_px2,"
+                       "var_centroid_v_px2,var_u_px2,var_v_px2\n";
+    for (const RbSample &r : rbp) {
+        char b[500];
+        snprintf(b, sizeof b, "%u,%.6f,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.5g,%.5g,%.5g,%.5g\n",
+                 r.run, r.axis_range_m, r.axis_bearing_rad, r.range_m, r.bearing_rad, r.cov_rr, r.cov_rb, r.cov_bb,
+                 r.du_centre_px, r.dv_centre_px, r.du_point_px, r.dv_point_px, r.bias_u_px, r.bias_v_px,
+                 r.var_centroid_u, r.var_centroid_v, r.var_u, r.var_v);
+        pcsv += b;
+    }
+    return pcsv;
+}
+
 void print_rb_tables(const char *title, const std::vector<RbSample> &s)
 {
     // Table 6/7 layout: rows binned by range (and bearing), mean of the bin.
@@ -207,18 +225,7 @@ int main(int argc, char **argv)
             rp.runs = runs;
             rp.seed = seed_given ? seed : 8;
             std::vector<RbSample> rbp = run_range_bearing(scene, table, rp);
-            std::string pcsv = "run,axis_range_m,axis_bearing_rad,range_m,bearing_rad,cov_rr,cov_rb,cov_bb,du_centroid_px,"
-                               "dv_centroid_px,du_point_px,dv_point_px,bias_u_px,bias_v_px,var_centroid_u_px2,"
-                               "var_centroid_v_px2,var_u_px2,var_v_px2\n";
-            for (const RbSample &r : rbp) {
-                char b[500];
-                snprintf(b, sizeof b, "%u,%.6f,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.5g,%.5g,%.5g,%.5g\n",
-                         r.run, r.axis_range_m, r.axis_bearing_rad, r.range_m, r.bearing_rad, r.cov_rr, r.cov_rb, r.cov_bb,
-                         r.du_centre_px, r.dv_centre_px, r.du_point_px, r.dv_point_px, r.bias_u_px, r.bias_v_px,
-                         r.var_centroid_u, r.var_centroid_v, r.var_u, r.var_v);
-                pcsv += b;
-            }
-            write_text(out + "/pixel_only.csv", pcsv);
+            write_text(out + "/pixel_only.csv", pixel_only_csv(rbp));
             RbStats sp = rb_stats(rbp);
             std::printf("{\"seed\":%llu,\"n\":%zu,\"pixel_only_mean_nees\":%.3f,\"range_frac_1sigma\":%.3f,"
                         "\"bearing_frac_1sigma\":%.3f}\n", (unsigned long long)rp.seed, sp.n, sp.mean_nees, sp.range_frac1,
@@ -362,20 +369,7 @@ int main(int argc, char **argv)
             zrp.push_back((r.range_m - r.axis_range_m) / std::sqrt(r.cov_rr));
             zbp.push_back((r.bearing_rad - r.axis_bearing_rad) / std::sqrt(r.cov_bb));
         }
-        {
-            std::string pcsv = "run,axis_range_m,axis_bearing_rad,range_m,bearing_rad,cov_rr,cov_rb,cov_bb,du_centroid_px,"
-                               "dv_centroid_px,du_point_px,dv_point_px,bias_u_px,bias_v_px,var_centroid_u_px2,"
-                               "var_centroid_v_px2,var_u_px2,var_v_px2\n";
-            for (const RbSample &r : rbp) {
-                char b[500];
-                snprintf(b, sizeof b, "%u,%.6f,%.6f,%.6f,%.6f,%.6g,%.6g,%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.5g,%.5g,%.5g,%.5g\n",
-                         r.run, r.axis_range_m, r.axis_bearing_rad, r.range_m, r.bearing_rad, r.cov_rr, r.cov_rb, r.cov_bb,
-                         r.du_centre_px, r.dv_centre_px, r.du_point_px, r.dv_point_px, r.bias_u_px, r.bias_v_px,
-                         r.var_centroid_u, r.var_centroid_v, r.var_u, r.var_v);
-                pcsv += b;
-            }
-            write_text(out + "/pixel_only.csv", pcsv);
-        }
+        write_text(out + "/pixel_only.csv", pixel_only_csv(rbp));
         plot_normalised_hist(out + "/range_normalised_errors_pixel_only.png", "range error / sigma (pixel noise only)", zrp);
         plot_normalised_hist(out + "/bearing_normalised_errors_pixel_only.png", "bearing error / sigma (pixel noise only)", zbp);
         std::printf("\nBias of the blob centroid against the projection of the landmark centre (axis, mid-height), px,\n"
