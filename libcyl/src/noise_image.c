@@ -387,7 +387,6 @@ typedef struct row_lists {
 /* first-run index of each grid row of the window, found by walking the list once */
 typedef struct row_index {
     uint32_t lead;         /* next list position not yet indexed */
-    int32_t lead_row;      /* rows < lead_row are indexed */
     uint32_t first[IMG_WIN];
     int32_t row_of[IMG_WIN];
 } row_index;
