@@ -59,7 +59,7 @@ $(BUILD)/bench_replay: bench/bench_replay.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
 	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) -O2 $< -o $@ $(FRONTEND_A) $(FE_SYNTH_OBJS) $(LIBCYL_A) $(CV_LIBS) -lm
 
 # ---- the cyl tool as a user meets it (exit codes, bad input, SIGINT) --------------------------
-TEST_EXTRA += $(BUILD)/cyl $(BUILD)/cyl-render
+TEST_EXTRA += $(BUILD)/cyl $(BUILD)/cyl-render $(BUILD)/cyl-synth-validate $(BUILD)/cyl_paper
 TEST_EXTRA_BINS += tests/frontend/test_cli.sh:$(BUILD)/cyl
 # every writer of every tool against a device node, a FIFO and symlinks (only regular files are replaced)
 TEST_EXTRA += $(BUILD)/cyl-train $(BUILD)/cyl-calibrate

@@ -18,6 +18,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "cylfe/version.hpp"
 #include "cylfe/calibration.hpp"
 #include "cylfe/error.hpp"
 #include "cylfe/overlay.hpp"
@@ -41,7 +42,7 @@ void on_signal(int)
 }
 
 const char *kUsage =
-    "usage: cyl <command> [options]\n"
+    "usage: cyl <command> [options]      (cyl --help, cyl --version)\n"
     "\n"
     "Find coloured cylinder landmarks and report range, bearing, colour, confidence and their\n"
     "covariance for every frame.\n"
@@ -472,6 +473,7 @@ int cmd_controls(const Args &a)
 
 int main(int argc, char **argv)
 {
+    if (cylfe::print_version_if_asked(argc, argv, "cyl")) return 0;
     Args a = parse(argc, argv);
     struct sigaction sa;
     std::memset(&sa, 0, sizeof sa);

@@ -9,6 +9,7 @@
 #include <vector>
 #include <unistd.h>
 
+#include "cylfe/version.hpp"
 #include "cylfe/calib.hpp"
 #include "cylfe/calibration.hpp"
 #include "cylfe/error.hpp"
@@ -23,6 +24,7 @@ constexpr double kDeg = 3.14159265358979323846 / 180.0;
 const char *kUsage =
     "usage: cyl-calibrate intrinsics [options] IMAGE...\n"
     "       cyl-calibrate mount --camera CAL.yaml [options] IMAGE...\n"
+    "       cyl-calibrate --help | --version\n"
     "\n"
     "intrinsics: detect a chessboard in each image (cv::findChessboardCorners + cornerSubPix),\n"
     "  start from a closed-form estimate, refine fx fy cx cy k1 k2 p1 p2 k3 and the view poses with\n"
@@ -348,6 +350,7 @@ int run_mount(const Args &a, const std::string &cmdline)
 
 int main(int argc, char **argv)
 {
+    if (cylfe::print_version_if_asked(argc, argv, "cyl-calibrate")) return 0;
     Args a;
     try {
         a = parse(argc, argv);

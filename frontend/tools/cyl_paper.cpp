@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "cylfe/version.hpp"
 #include "cylfe/calibration.hpp"
 #include "cylfe/error.hpp"
 
@@ -95,6 +96,7 @@ cyl_observation observe(const cyl_camera &cam, cyl_geom_model model, double rang
 
 int main(int argc, char **argv)
 {
+    if (cylfe::print_version_if_asked(argc, argv, "cyl_paper")) return 0;
     std::string cam_path = "calib_data/paper_camera.yaml";
     cyl_geom_model model = CYL_GEOM_EXACT;
     double D = 0.10, H = 0.10;  // largest fully visible at the 1.19 m row (docs)
@@ -113,7 +115,7 @@ int main(int argc, char **argv)
         } else if (a == "--diameter") D = std::stod(val());
         else if (a == "--height") H = std::stod(val());
         else if (a == "-h" || a == "--help") {
-            std::printf("usage: cyl_paper [--camera FILE] [--model exact|paper] [--diameter M] [--height M]\n");
+            std::printf("usage: cyl_paper [--camera FILE] [--model exact|paper] [--diameter M] [--height M] [--version]\n");
             return 0;
         } else { std::fprintf(stderr, "cyl_paper: unknown argument %s\n", a.c_str()); return cylfe::kExitUsage; }
     }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // cyl-render: render a synthetic drive (frames, odometry, ground truth) into a raw frame log
 // (*.cylraw, docs/formats.md); also writes scene files, the scene's colour table and camera.
+#include "cylfe/version.hpp"
 #include "cylfe/error.hpp"
 #include "cylfe/progress.hpp"
 #include "cylfe/rawlog.hpp"
@@ -47,6 +48,7 @@ void usage(FILE *f)
         "      --write-camera PATH write the scene camera as a calibration YAML and exit\n"
         "  -q, --quiet             no progress bar\n"
         "  -h, --help              this help\n"
+        "      --version           the version\n"
         "\n"
         "Outputs: a regular file (or a new path) is written as PATH.part and renamed at the end; a\n"
         "device node or FIFO is written in place, a symbolic link through to its file; a dangling\n"
@@ -80,6 +82,7 @@ void write_file(const std::string &path, const uint8_t *data, size_t n)
 
 int main(int argc, char **argv)
 {
+    if (cylfe::print_version_if_asked(argc, argv, "cyl-render")) return 0;
     std::string out = "build/drive.cylraw", scene_name = "default", write_scene, write_table, write_camera;
     uint64_t frames = 1000, seed = 7, samples = 0;
     bool quiet = false, calib_error = false;

@@ -3,6 +3,7 @@
 // Prints Tables 1-3 and 6-7 in the paper's layout beside the paper's figures, the blob-centroid
 // bias, the confidence check; writes PNG plots and CSVs into --out; the last line of stdout is a
 // JSON summary.
+#include "cylfe/version.hpp"
 #include "cylfe/error.hpp"
 #include "cylfe/synth.hpp"
 #include "cylfe/synth_experiments.hpp"
@@ -45,7 +46,7 @@ void usage(FILE *f)
         "                   (default 1), and of the range/bearing runs (default 7 with calibration\n"
         "                   errors, 8 pixel noise only); seeds 1-20 chose the settings, 101-120 are held out\n"
         "  --quick          reduced sizes (frames 120, runs 150, conf-frames 300)\n"
-        "  -h, --help\n");
+        "  -h, --help, --version\n");
 }
 
 struct Timer {
@@ -176,6 +177,7 @@ void print_rb_tables(const char *title, const std::vector<RbSample> &s)
 
 int main(int argc, char **argv)
 {
+    if (cylfe::print_version_if_asked(argc, argv, "cyl-synth-validate")) return 0;
     std::string out = "build/validate", scene_name = "default";
     unsigned frames = 400, runs = 500, conf_frames = 600;
     bool sweep = false, sweep_only = false, pixel_only = false;

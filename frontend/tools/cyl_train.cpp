@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "cylfe/version.hpp"
 #include "cylfe/calib.hpp"
 #include "cylfe/error.hpp"
 
@@ -24,6 +25,7 @@ namespace {
 const char *kUsage =
     "usage: cyl-train -o TABLE.cylt [--base IN.cylt] [params] STEP...\n"
     "       cyl-train --gui IMAGE|LOG.cylraw [--frame N] -o TABLE.cylt [--base IN.cylt] [--class NAME]...\n"
+    "       cyl-train --help | --version\n"
     "\n"
     "Trains libcyl colour classes (cyl_colortable_train: a UV histogram of the region, thresholded,\n"
     "its bounding rectangle grown by a margin, and a Y window from the brightness quantiles) and\n"
@@ -310,6 +312,7 @@ int run_gui(Opts &o, cyl_colortable &t, const cyl_train_params &params)
 
 int main(int argc, char **argv)
 {
+    if (cylfe::print_version_if_asked(argc, argv, "cyl-train")) return 0;
     Opts o;
     std::vector<std::pair<std::string, std::string>> steps;  // (option, value) in order
     try {

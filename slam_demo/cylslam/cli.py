@@ -437,6 +437,8 @@ def build_parser():
                                  description="Landmark SLAM (GTSAM) with per-observation covariance. "
                                              "Exit codes: 0 ok, 1 check failed, 2 usage, 3 input error, "
                                              "4 cannot write the outputs.")
+    from . import __version__
+    ap.add_argument("--version", action="version", version=f"cylslam {__version__}")
     sub = ap.add_subparsers(dest="cmd", required=True)
 
     sp = sub.add_parser("run", help="SLAM on an observation log (docs/formats.md)",

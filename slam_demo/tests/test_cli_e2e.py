@@ -140,3 +140,13 @@ def test_cli_run_behind_cyl_detect_pipe(tmp_path):
     assert r.returncode == 0, r.stderr
     assert "60 poses" in r.stdout
     assert json.loads(r.stdout.strip().splitlines()[-1])["ate_m"] < 0.05
+
+
+def test_version_is_the_librarys():
+    import re
+    import cylslam
+    hdr = open(os.path.join(os.path.dirname(os.path.dirname(HERE)), "libcyl", "include", "cyl", "version.h")).read()
+    v = re.search(r'#define CYL_VERSION_STRING "([^"]+)"', hdr).group(1)
+    assert cylslam.__version__ == v
+    r = _cli("--version")
+    assert r.returncode == 0 and r.stdout.strip() == f"cylslam {v}"

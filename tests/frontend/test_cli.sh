@@ -158,6 +158,18 @@ print(t.count('frame'), t.count('odom'), t.count('truth_pose'))" "$T/mf2.jsonl")
 [ "$counts" = "4 4 4" ] || fail "recorded with --max-frames 4: frames, odom, truth_pose $counts (expected 4 4 4)"
 finish
 
+# --version on every tool: "<tool> <version> (libcyl <version>)", the version from cyl/version.h
+start version_on_every_tool
+hv=$(sed -n 's/^#define CYL_VERSION_STRING "\(.*\)"/\1/p' libcyl/include/cyl/version.h)
+B=$(dirname "$CYL")
+for t in cyl cyl-render cyl-train cyl-calibrate cyl-synth-validate cyl_paper; do
+  [ -x "$B/$t" ] || { fail "$B/$t not built"; continue; }
+  out=$("$B/$t" --version 2>&1); rc=$?
+  [ $rc -eq 0 ] || fail "$t --version: exit $rc"
+  [ "$out" = "$t $hv (libcyl $hv)" ] || fail "$t --version printed '$out'"
+done
+finish
+
 echo "[==========] $((passed + failed)) tests ran."
 echo "[  PASSED  ] $passed tests."
 [ $failed -eq 0 ] || echo "[  FAILED  ] $failed tests."
