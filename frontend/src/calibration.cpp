@@ -8,6 +8,7 @@
 #include <cstring>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <vector>
 #include <unistd.h>
@@ -101,9 +102,71 @@ void check_shape(const std::string &path, const std::string &text)
     if (max_depth > 16) throw Error(path + ": not a calibration file: nested more than 16 levels");
 }
 
+// Top-level keys of a calibration file. Used: what this loader reads. Accepted and not used: what
+// OpenCV's calibration sample and ROS camera_info files also carry, so that such files load. Any
+// other key is an error naming it and the nearest known key (a misspelled key must not silently
+// become a default: "distortion_coeficients" would be zero distortion).
+const char *const kUsedKeys[] = {"image_width", "image_height", "camera_matrix", "distortion_coefficients",
+                                 "distortion_model", "intrinsic_covariance", "intrinsic_sigmas", "mount_tilt_deg",
+                                 "mount_yaw_deg", "mount_height_m", "mount_offset_m", "mount_tilt_sigma_deg",
+                                 "mount_yaw_sigma_deg", "mount_height_sigma_m", "mount_offset_sigma_m"};
+const char *const kIgnoredKeys[] = {
+    "camera_name", "rectification_matrix", "projection_matrix",                         // ROS camera_info
+    "calibration_time", "nframes", "nr_of_frames", "board_width", "board_height", "square_size",
+    "aspectRatio", "fix_aspect_ratio", "flags", "fisheye_model", "avg_reprojection_error",
+    "per_view_reprojection_errors", "extrinsic_parameters", "image_points", "grid_points"};  // OpenCV sample
+
+size_t edit_distance(const std::string &a, const std::string &b)
+{
+    std::vector<size_t> d(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); j++) d[j] = j;
+    for (size_t i = 1; i <= a.size(); i++) {
+        size_t prev = d[0];
+        d[0] = i;
+        for (size_t j = 1; j <= b.size(); j++) {
+            size_t cur = d[j];
+            d[j] = std::min({d[j] + 1, d[j - 1] + 1, prev + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            prev = cur;
+        }
+    }
+    return d[b.size()];
+}
+
+// Duplicate keys are errors (YAML says a mapping's keys are unique; yaml-cpp keeps the first);
+// unknown keys are errors, or warnings when lenient.
+void check_keys(const Ctx &c, const Node &root, int line_offset, bool lenient, std::vector<std::string> *warnings)
+{
+    std::map<std::string, int> seen;
+    for (auto it = root.begin(); it != root.end(); ++it) {
+        if (!it->first.IsScalar()) c.fail("(top level)", "a key that is not a plain name");
+        const std::string k = it->first.Scalar();
+        const int line = it->first.Mark().line + 1 + line_offset;
+        auto s = seen.find(k);
+        if (s != seen.end())
+            c.fail(k, "given twice (lines " + std::to_string(s->second) + " and " + std::to_string(line) + ")");
+        seen[k] = line;
+        bool known = false;
+        std::string nearest;
+        size_t best = 4;  // suggest only within 3 edits
+        for (const char *const *set : {kUsedKeys, kIgnoredKeys}) {
+            const size_t n = set == kUsedKeys ? sizeof kUsedKeys / sizeof *kUsedKeys : sizeof kIgnoredKeys / sizeof *kIgnoredKeys;
+            for (size_t i = 0; i < n; i++) {
+                if (k == set[i]) known = true;
+                size_t d = edit_distance(k, set[i]);
+                if (d < best) { best = d; nearest = set[i]; }
+            }
+        }
+        if (known) continue;
+        std::string msg = c.path + ":" + std::to_string(line) + ": unknown key '" + k + "'" +
+                          (nearest.empty() ? std::string() : " (did you mean '" + nearest + "'?)");
+        if (!lenient) throw Error(msg + "; --lenient reads the file anyway");
+        if (warnings) warnings->push_back(msg + ": ignored (--lenient)");
+    }
+}
+
 } // namespace
 
-static CameraCalibration load_unchecked(const std::string &path)
+static CameraCalibration load_unchecked(const std::string &path, bool lenient)
 {
     std::ifstream f(path, std::ios::binary);
     if (!f) throw Error(path + ": cannot open camera calibration file");
@@ -127,6 +190,7 @@ static CameraCalibration load_unchecked(const std::string &path)
     }
     Ctx c{path};
     if (!root.IsMap()) throw Error(path + ": not a calibration file: the top level is not a mapping of fields");
+    check_keys(c, root, cal.format == "opencv" ? 1 : 0, lenient, &cal.warnings);
     cyl_camera &cam = cal.cam;
     cyl_camera_init(&cam);
     cam.height_m = 0.0;
@@ -222,10 +286,10 @@ static CameraCalibration load_unchecked(const std::string &path)
     return cal;
 }
 
-CameraCalibration load_camera_calibration(const std::string &path)
+CameraCalibration load_camera_calibration(const std::string &path, bool lenient)
 {
     try {
-        return load_unchecked(path);
+        return load_unchecked(path, lenient);
     } catch (const Error &) {
         throw;
     } catch (const std::exception &e) {

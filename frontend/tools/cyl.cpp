@@ -81,6 +81,8 @@ const char *kUsage =
     "  --max-frames N       stop after N frames\n"
     "  --realtime           replay raw logs at the recorded pace (default: as fast as possible)\n"
     "  --quiet              no progress or summary on stderr\n"
+    "  --lenient            unknown keys in the --calib file are warnings, not errors (a key given\n"
+    "                       twice is always an error)\n"
     "record options: --out FILE.cylraw (required), --max-frames N\n"
     "V4L2 options: --format FOURCC --size-px WxH --fps F --buffers N --timeout-ms MS --input N\n"
     "              --fixed-exposure (turn auto exposure, white balance and gain off: colour tables\n"
@@ -95,7 +97,7 @@ struct Args {
     std::vector<std::string> sizes, controls;
     double var_floor_px2 = 0.0;
     uint64_t max_frames = 0;
-    bool show = false, quiet = false, fixed_exposure = false;
+    bool show = false, quiet = false, fixed_exposure = false, lenient = false;
     SourceOptions src;
 };
 
@@ -160,6 +162,7 @@ Args parse(int argc, char **argv)
         else if (s == "--max-frames") a.max_frames = parse_u64(s, val(s));
         else if (s == "--realtime") a.src.realtime = true;
         else if (s == "--quiet" || s == "-q") a.quiet = true;
+        else if (s == "--lenient") a.lenient = true;
         else if (s == "--device") a.src.v4l2.device = val(s);
         else if (s == "--format") {
             std::string f = val(s);
@@ -258,7 +261,8 @@ int cmd_detect(const Args &a)
     cfg.observe.min_var_px2 = a.var_floor_px2;
     cyl_camera cam;
     if (!a.calib.empty()) {
-        CameraCalibration cal = load_camera_calibration(a.calib);
+        CameraCalibration cal = load_camera_calibration(a.calib, a.lenient);
+        for (const std::string &w : cal.warnings) std::fprintf(stderr, "cyl: warning: %s\n", w.c_str());
         if (!cal.mount_known) throw Error(a.calib + ": no mount fields (mount_tilt_deg, mount_height_m, ...): range "
                                           "and bearing need the camera's mounting");
         cam = cal.cam;

@@ -32,6 +32,23 @@ chmod +x "$T/detect"
 
 : > "$T/empty"
 check empty_table 1 "empty: table file truncated" -- "$T/detect" "$T/s.cylraw" "$T/empty" $CALIB
+# calibration keys: a misspelled key is an error naming it and the nearest known key (it would
+# otherwise silently become a default: no distortion); --lenient makes it a warning; a key given
+# twice is an error either way
+sed "s/^distortion_coefficients:/distortion_coeficients:/" $CALIB > "$T/typo.yaml"
+check calib_misspelled_key 1 "typo.yaml:[0-9]+: unknown key 'distortion_coeficients' \(did you mean 'distortion_coefficients'\?\)" \
+  -- "$T/detect" "$T/s.cylraw" $TABLE "$T/typo.yaml"
+echo "[ RUN      ] bad_input.calib_misspelled_key_lenient"
+if "$CYL" detect "$T/s.cylraw" --table $TABLE --calib "$T/typo.yaml" --lenient --out "$T/len.jsonl" --quiet 2>"$T/err" &&
+   grep -q "warning: .*typo.yaml:[0-9]*: unknown key 'distortion_coeficients'.*ignored (--lenient)" "$T/err"; then
+  passed=$((passed + 1)); echo "[       OK ] bad_input.calib_misspelled_key_lenient"
+else failed=$((failed + 1)); echo "  $(head -c 300 "$T/err")"; echo "[  FAILED  ] bad_input.calib_misspelled_key_lenient"; fi
+sed "s/^intrinsic_covariance:/intrinsic_covarience:/" $CALIB > "$T/typo2.yaml"
+check calib_misspelled_covariance 1 "unknown key 'intrinsic_covarience' \(did you mean 'intrinsic_covariance'\?\)" \
+  -- "$T/detect" "$T/s.cylraw" $TABLE "$T/typo2.yaml"
+{ cat $CALIB; echo "mount_tilt_deg: 30"; } > "$T/dup.yaml"
+check calib_duplicate_key 1 "dup.yaml: field 'mount_tilt_deg': given twice \(lines [0-9]+ and [0-9]+\)" \
+  -- "$T/detect" "$T/s.cylraw" $TABLE "$T/dup.yaml"
 # --show without a display: a clear usage error, not Qt's abort (exit 134), and no .part left
 check show_without_display 2 "--show needs a display" -- env -u DISPLAY -u WAYLAND_DISPLAY "$CYL" detect "$T/s.cylraw" \
   --table $TABLE --calib $CALIB --out "$T/good.jsonl" --show --quiet

@@ -22,6 +22,7 @@
 // Errors throw cylfe::Error naming the file and the field.
 #pragma once
 #include <string>
+#include <vector>
 
 extern "C" {
 #include "cyl/camera.h"
@@ -36,11 +37,14 @@ struct CameraCalibration {
     bool intrinsic_cov_known = false; // intrinsic_sigmas or intrinsic_covariance present
     bool mount_known = false;         // all four mount values present
     bool mount_sigmas_known = false;  // all four mount sigmas present
+    std::vector<std::string> warnings; // lenient loads: each unknown key, "FILE:LINE: ..."
 };
 
 // Load a calibration file (either format). Throws cylfe::Error on a missing file, unparsable
-// YAML, a missing or malformed required field, or an invalid camera (cyl_camera_check).
-CameraCalibration load_camera_calibration(const std::string &path);
+// YAML, a missing or malformed required field, a key given twice, an unknown top-level key (naming
+// the nearest known one; with lenient, a warning in .warnings instead), or an invalid camera
+// (cyl_camera_check).
+CameraCalibration load_camera_calibration(const std::string &path, bool lenient = false);
 
 // Write cam as OpenCV FileStorage YAML with libcyl's fields, through "<path>.tmp.<pid>" renamed
 // into place (a good file is never replaced by a partial one). The intrinsic covariance is left
