@@ -284,9 +284,21 @@ int cmd_detect(const Args &a)
         if (cls < 0) usage_error("--size: class '" + s.substr(0, eq) + "' is not in " + table_path);
         cfg.observe.size[cls] = {d, h};
     }
+    // A class without a size gets confidence 0 on every observation, and a SLAM back end that
+    // filters on confidence then uses none of them: say so.
+    for (unsigned k = 0; k < CYL_MAX_CLASSES; k++)
+        if (table.name[k][0] && !(cfg.observe.size[k].diameter_m > 0 && cfg.observe.size[k].height_m > 0))
+            std::fprintf(stderr, "cyl: warning: class '%s' has no landmark size (--size %s=D,H): its observations get "
+                                 "confidence 0\n", table.name[k], table.name[k]);
 
     std::unique_ptr<Source> src = open_source(a.source, a.src);
     apply_v4l2_options(*src, a, a.quiet);
+    // The calibration holds for the image size it was made at only.
+    if (src->info().width != cam.width || src->info().height != cam.height)
+        throw Error((a.calib.empty() ? std::string("the camera") : a.calib) + ": calibrated for " +
+                    std::to_string(cam.width) + "x" + std::to_string(cam.height) + " px, but " + a.source + " gives " +
+                    std::to_string(src->info().width) + "x" + std::to_string(src->info().height) +
+                    " px frames: calibrate at this size or capture at the calibrated one (--size-px)");
     Detector det(table, cam, cfg);
     ObservationLog::Header hdr;
     hdr.source = src->info().source.empty() ? a.source : src->info().source;

@@ -49,6 +49,15 @@ check calib_misspelled_covariance 1 "unknown key 'intrinsic_covarience' \(did yo
 { cat $CALIB; echo "mount_tilt_deg: 30"; } > "$T/dup.yaml"
 check calib_duplicate_key 1 "dup.yaml: field 'mount_tilt_deg': given twice \(lines [0-9]+ and [0-9]+\)" \
   -- "$T/detect" "$T/s.cylraw" $TABLE "$T/dup.yaml"
+# frames of another size than the calibration's: an error naming both sizes, before any output
+check frame_size_mismatch 1 "paper_camera.yaml: calibrated for 768x576 px, but synthetic:2 gives 640x480 px" -- \
+  "$CYL" detect synthetic:2 --calib calib_data/paper_camera.yaml --max-frames 2 --out "$T/good.jsonl" --quiet
+# no --size for a class: runs, and warns that its observations get confidence 0
+echo "[ RUN      ] bad_input.missing_size_warns"
+if "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB --out "$T/w.jsonl" --quiet 2>"$T/err" &&
+   grep -q "warning: class 'orange' has no landmark size (--size orange=D,H): its observations get confidence 0" "$T/err"; then
+  passed=$((passed + 1)); echo "[       OK ] bad_input.missing_size_warns"
+else failed=$((failed + 1)); echo "  $(head -c 300 "$T/err")"; echo "[  FAILED  ] bad_input.missing_size_warns"; fi
 # --show without a display: a clear usage error, not Qt's abort (exit 134), and no .part left
 check show_without_display 2 "--show needs a display" -- env -u DISPLAY -u WAYLAND_DISPLAY "$CYL" detect "$T/s.cylraw" \
   --table $TABLE --calib $CALIB --out "$T/good.jsonl" --show --quiet
