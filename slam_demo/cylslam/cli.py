@@ -307,7 +307,7 @@ def cmd_synth(args):
 def cmd_run(args):
     from .obslog import ObsLogError, read_obslog
     try:
-        ds = read_obslog(args.log, skip_bad=args.skip_bad)
+        ds = read_obslog(args.log, skip_bad=args.skip_bad, bridge_gaps=args.bridge_gaps)
     except (ObsLogError, OSError) as e:
         print(f"cylslam: error: {e}", file=sys.stderr)
         return EXIT_INPUT
@@ -446,6 +446,10 @@ def build_parser():
                                     "truth lines, print metrics. Last stdout line: JSON.")
     sp.add_argument("log", help="observation log (.jsonl); - reads standard input to its end, e.g. behind "
                     "`cyl detect SOURCE --out -`")
+    sp.add_argument("--bridge-gaps", action="store_true",
+                    help="a frame without its odom line in a log with odometry (a lost step of the "
+                         "robot's motion) is an error; with this, a zero-motion step with large sigmas "
+                         "spans it (reported)")
     sp.add_argument("--skip-bad", action="store_true",
                     help="skip malformed lines (counted and listed) instead of stopping at the first")
     sp.add_argument("--check", action="store_true",

@@ -16,8 +16,11 @@ wrong type or a non-finite number, has a covariance that is not symmetric positi
 or belongs to another frame than the `frame` line before it.
 
 Frames become steps: each `frame` with an `odom` line is one pose; the first frame is the start
-pose (its odom line, if any, has no previous pose and is ignored); the observations of a later
-frame without `odom` are attached to the previous pose (counted in the notes).
+pose (its odom line, if any, has no previous pose and is ignored). In a log without odometry (a
+camera alone) the observations of later frames are attached to the first pose (counted in the
+notes). In a log with odometry a later frame without an `odom` line is a lost step of the robot's
+motion (e.g. a malformed odom line skipped by skip_bad): an error naming it, or with bridge_gaps a
+zero-motion step with large sigmas (BRIDGE_SIGMAS), reported in the notes.
 
 Optional field (a proposed extension of the format): `"landmark_id": int` on an `obs` line for
 sources that know identities; when every usable observation has one the back end may use known
@@ -107,6 +110,12 @@ def _check_cov(m, where, what, rtol=1e-12):
                           f"(eigenvalues {ev.tolist()})")
 
 
+# Sigmas of the zero-motion step that --bridge-gaps puts where an odometry step was lost (x, y in
+# m, theta in rad): ten times a step of the synthetic drive (0.02 m, 0.03 rad), so the lost motion
+# is well inside them.
+BRIDGE_SIGMAS = (0.2, 0.2, 0.3)
+
+
 class _Builder:
     def __init__(self, path):
         self.path = path
@@ -116,6 +125,7 @@ class _Builder:
         self.last_seq = None     # seq of the last frame line (frames without odom included)
         self.n_no_odom = 0
         self.n_first_odom = 0
+        self.gaps = []           # (line, seq) of later frames without an odom line
         self.unknown_types = {}
 
     def flush_frame(self):
@@ -131,12 +141,50 @@ class _Builder:
                 self.n_first_odom += 1
             self.steps.append(Step(t=f["t"], seq=f["seq"], obs=f["obs"], truth=f["truth"]))
             return
-        if f["odom"] is None:
-            self.n_no_odom += 1
-            self.steps[-1].obs.extend(f["obs"])
+        if f["odom"] is None:   # resolved by finish(): no odometry at all, or a lost step
+            self.gaps.append((f["line"], f["seq"]))
+            self.steps.append(Step(t=f["t"], seq=f["seq"], obs=f["obs"], truth=f["truth"]))
             return
         self.steps.append(Step(t=f["t"], seq=f["seq"], odom=f["odom"][0], odom_cov=f["odom"][1],
                                obs=f["obs"], truth=f["truth"]))
+
+    def finish(self, bridge_gaps, notes):
+        """Frames after the first without an odom line. In a log without any odometry (a camera
+        alone) their observations join the previous pose. In a log with odometry each is a lost
+        step of the robot's motion: an error naming it, or with bridge_gaps a zero-motion step
+        whose sigmas (BRIDGE_SIGMAS) cover any motion between two frames."""
+        if not self.gaps:
+            return
+        has_odom = any(s.odom is not None for s in self.steps[1:])
+        if has_odom and self.gaps[-1][1] == self.steps[-1].seq:
+            # the log ends with a frame whose odom line was never written (an interrupted writer,
+            # or a --max-frames cut before this was fixed): an incomplete last frame, dropped
+            last = self.steps.pop()
+            notes.append(f"{self.path}:{self.gaps[-1][0]}: the last frame (seq {last.seq}) has no odom line: "
+                         f"dropped as incomplete, with its {len(last.obs)} observation(s)")
+            self.gaps.pop()
+            if not self.gaps:
+                return
+        if not has_odom:
+            merged = [self.steps[0]]
+            for s in self.steps[1:]:
+                merged[-1].obs.extend(s.obs)
+            self.steps = merged
+            self.n_no_odom = len(self.gaps)
+            return
+        where = "; ".join(f"{self.path}:{ln} (frame seq {sq})" for ln, sq in self.gaps[:10])
+        more = f" and {len(self.gaps) - 10} more" if len(self.gaps) > 10 else ""
+        if not bridge_gaps:
+            raise ObsLogError(f"{self.path}:{self.gaps[0][0]}: frame seq {self.gaps[0][1]} has no odom line in a "
+                              f"log with odometry: a step of the robot's motion is lost ({len(self.gaps)} "
+                              f"such frame(s): {where}{more}); --bridge-gaps spans each with a zero-motion step "
+                              f"of sigmas {BRIDGE_SIGMAS[0]} m, {BRIDGE_SIGMAS[1]} m, {BRIDGE_SIGMAS[2]} rad")
+        for s in self.steps[1:]:
+            if s.odom is None:
+                s.odom = np.zeros(3)
+                s.odom_cov = np.diag(np.square(BRIDGE_SIGMAS))
+        notes.append(f"bridged {len(self.gaps)} lost odometry step(s) with zero motion and sigmas "
+                     f"{BRIDGE_SIGMAS[0]} m, {BRIDGE_SIGMAS[1]} m, {BRIDGE_SIGMAS[2]} rad: {where}{more}")
 
     def _frame_of(self, rec, where, kind):
         seq = _int(rec, "seq", where)
@@ -222,22 +270,22 @@ class _Builder:
             raise ObsLogError(f"{where}: missing or non-string 'type'")
 
 
-def read_obslog(path, skip_bad=False) -> Dataset:
+def read_obslog(path, skip_bad=False, bridge_gaps=False) -> Dataset:
     """Read an observation log into a Dataset. Raises ObsLogError (strict) or skips bad lines.
     path "-" reads standard input to its end (e.g. behind `cyl detect ... --out -`); messages then
     name it "<stdin>"."""
     if path == "-":
         import sys
-        return parse_obslog(sys.stdin.buffer.read(), "<stdin>", skip_bad)
+        return parse_obslog(sys.stdin.buffer.read(), "<stdin>", skip_bad, bridge_gaps)
     try:
         with open(path, "rb") as fh:
             raw = fh.read()
     except OSError as e:
         raise ObsLogError(f"{path}: cannot read ({e.strerror})") from None
-    return parse_obslog(raw, path, skip_bad)
+    return parse_obslog(raw, path, skip_bad, bridge_gaps)
 
 
-def parse_obslog(raw: bytes, path="<bytes>", skip_bad=False) -> Dataset:
+def parse_obslog(raw: bytes, path="<bytes>", skip_bad=False, bridge_gaps=False) -> Dataset:
     """Parse the bytes of an observation log; `path` only names it in messages."""
     lines = raw.split(b"\n")
     truncated_tail = bool(lines and lines[-1] != b"")
@@ -298,6 +346,7 @@ def parse_obslog(raw: bytes, path="<bytes>", skip_bad=False) -> Dataset:
     b.flush_frame()
     if not b.steps:
         raise ObsLogError(f"{path}: no frames")
+    b.finish(bridge_gaps, notes)
     if skipped:
         notes.append(f"skipped {len(skipped)} malformed line(s); first: {skipped[0]}")
         notes.extend(f"  skipped: {s}" for s in skipped[1:10])

@@ -58,7 +58,11 @@ def test_cli_malformed_exit_code_and_message(tmp_path):
     assert r.returncode == 3
     assert f"{mal}:7: not valid JSON" in r.stderr
     r = _cli("run", mal, "--skip-bad", "--no-plot", "--fixed-cov", "none", "--out", str(tmp_path))
+    assert r.returncode == 3 and "frame seq 4 has no odom line" in r.stderr   # a lost step
+    r = _cli("run", mal, "--skip-bad", "--bridge-gaps", "--no-plot", "--fixed-cov", "none", "--out",
+             str(tmp_path))
     assert r.returncode == 0, r.stderr
+    assert "bridged 1 lost odometry step(s)" in r.stdout
     assert "skipped 5 malformed line(s)" in r.stdout
     assert json.loads(r.stdout.strip().splitlines()[-1])["skipped_lines"] == 5
 

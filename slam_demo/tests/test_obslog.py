@@ -34,17 +34,21 @@ def test_malformed_strict_names_file_and_line():
 
 
 def test_malformed_skip_counts_every_bad_line():
-    ds = read_obslog(MAL, skip_bad=True)
+    # line 19, frame 4's odom line, is malformed: skipping it loses a step of the motion, which
+    # is an error of its own unless bridged
+    with pytest.raises(ObsLogError, match=r"malformed.jsonl:17: frame seq 4 has no odom line"):
+        read_obslog(MAL, skip_bad=True)
+    ds = read_obslog(MAL, skip_bad=True, bridge_gaps=True)
     assert ds.n_skipped == 5
     text = "\n".join(ds.notes)
     for line in (7, 11, 15, 18, 19):
         assert f"{MAL}:{line}:" in text
     assert "truncated last line" in text and f"{MAL}:23" in text
     assert "unknown type 'future_record'" in text
-    assert "1 frame(s) without odometry" in text
+    assert f"bridged 1 lost odometry step(s)" in text and f"{MAL}:17 (frame seq 4)" in text
     # the good observations are all kept: lines 4, 10, 21
     assert [o.range_m for s in ds.steps for o in s.obs] == [2.0, 1.8, 1.5]
-    assert [s.seq for s in ds.steps] == [0, 1, 2, 3, 5]
+    assert [s.seq for s in ds.steps] == [0, 1, 2, 3, 4, 5]
 
 
 @pytest.mark.parametrize("line,msg", [
@@ -180,3 +184,50 @@ def test_singular_odometry_only_an_error_when_used(tmp_path):
                  '{"type":"frame","seq":1,"t":0.1}\n' + odo % 1)
     with pytest.raises(ObsLogError, match=r"o.jsonl:5: odometry covariance is singular"):
         read_obslog(str(p))
+
+
+
+def test_lost_odometry_step_is_an_error_unless_bridged():
+    # the odom line of frame 150 lost: the robot's motion in that step is unknown
+    from cylslam.obslog import BRIDGE_SIGMAS, parse_obslog
+    src = os.path.join(FIXTURES, "synth_short.jsonl")
+    text = open(src).read()
+    tag = '{"type":"odom","seq":150,'
+    assert text.count(tag) == 1
+    lines = text.splitlines(keepends=True)
+    k = next(i for i, l in enumerate(lines) if l.startswith(tag))
+    raw = "".join(lines[:k] + lines[k + 1:]).encode()
+    with pytest.raises(ObsLogError, match=r"frame seq 150 has no odom line in a log with odometry"):
+        parse_obslog(raw, "lost.jsonl")
+    # a malformed odom line skipped by skip_bad is the same loss: still an error, not silence
+    bad = lines[:k] + [lines[k].replace('"dx_m":', '"dx_m":"x","dy":', 1)] + lines[k + 1:]
+    with pytest.raises(ObsLogError, match=r"frame seq 150 has no odom line"):
+        parse_obslog("".join(bad).encode(), "bad.jsonl", skip_bad=True)
+    ds = parse_obslog(raw, "lost.jsonl", bridge_gaps=True)
+    ref = parse_obslog(text.encode(), "ref.jsonl")
+    assert len(ds.steps) == len(ref.steps)
+    s = next(s for s in ds.steps if s.seq == 150)
+    assert np.allclose(s.odom, 0) and np.allclose(np.sqrt(np.diag(s.odom_cov)), BRIDGE_SIGMAS)
+    assert any("bridged 1 lost odometry step" in n and f"lost.jsonl:" in n for n in ds.notes)
+
+
+def test_log_without_odometry_attaches_observations_to_the_first_pose():
+    from cylslam.obslog import parse_obslog
+    src = os.path.join(FIXTURES, "synth_short.jsonl")
+    raw = "".join(l for l in open(src) if '"type":"odom"' not in l).encode()
+    ds = parse_obslog(raw, "camera_only.jsonl")
+    ref = parse_obslog(open(src, "rb").read(), "ref.jsonl")
+    assert len(ds.steps) == 1 and ds.n_obs() == ref.n_obs()
+    assert any("without odometry" in n for n in ds.notes)
+
+
+def test_incomplete_last_frame_is_dropped_with_a_note():
+    # a writer interrupted between a frame line and its odom line: the log ends one step short
+    from cylslam.obslog import parse_obslog
+    src = os.path.join(FIXTURES, "synth_short.jsonl")
+    lines = open(src).read().splitlines(keepends=True)
+    k = max(i for i, l in enumerate(lines) if l.startswith('{"type":"odom",'))
+    ds = parse_obslog("".join(lines[:k]).encode(), "cut.jsonl")
+    ref = parse_obslog(open(src, "rb").read(), "ref.jsonl")
+    assert len(ds.steps) == len(ref.steps) - 1
+    assert any("the last frame" in n and "dropped as incomplete" in n for n in ds.notes)
