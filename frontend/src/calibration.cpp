@@ -8,6 +8,7 @@
 #include <cstring>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <vector>
@@ -17,6 +18,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "cylfe/error.hpp"
+#include "cylfe/keys.hpp"
 #include "cylfe/output_file.hpp"
 
 extern "C" {
@@ -116,27 +118,13 @@ const char *const kIgnoredKeys[] = {
     "aspectRatio", "fix_aspect_ratio", "flags", "fisheye_model", "avg_reprojection_error",
     "per_view_reprojection_errors", "extrinsic_parameters", "image_points", "grid_points"};  // OpenCV sample
 
-size_t edit_distance(const std::string &a, const std::string &b)
-{
-    std::vector<size_t> d(b.size() + 1);
-    for (size_t j = 0; j <= b.size(); j++) d[j] = j;
-    for (size_t i = 1; i <= a.size(); i++) {
-        size_t prev = d[0];
-        d[0] = i;
-        for (size_t j = 1; j <= b.size(); j++) {
-            size_t cur = d[j];
-            d[j] = std::min({d[j] + 1, d[j - 1] + 1, prev + (a[i - 1] == b[j - 1] ? 0 : 1)});
-            prev = cur;
-        }
-    }
-    return d[b.size()];
-}
-
 // Duplicate keys are errors (YAML says a mapping's keys are unique; yaml-cpp keeps the first);
 // unknown keys are errors, or warnings when lenient.
 void check_keys(const Ctx &c, const Node &root, int line_offset, bool lenient, std::vector<std::string> *warnings)
 {
     std::map<std::string, int> seen;
+    std::vector<std::string> all(std::begin(kUsedKeys), std::end(kUsedKeys));
+    all.insert(all.end(), std::begin(kIgnoredKeys), std::end(kIgnoredKeys));
     for (auto it = root.begin(); it != root.end(); ++it) {
         if (!it->first.IsScalar()) c.fail("(top level)", "a key that is not a plain name");
         const std::string k = it->first.Scalar();
@@ -145,20 +133,9 @@ void check_keys(const Ctx &c, const Node &root, int line_offset, bool lenient, s
         if (s != seen.end())
             c.fail(k, "given twice (lines " + std::to_string(s->second) + " and " + std::to_string(line) + ")");
         seen[k] = line;
-        bool known = false;
-        std::string nearest;
-        size_t best = 4;  // suggest only within 3 edits
-        for (const char *const *set : {kUsedKeys, kIgnoredKeys}) {
-            const size_t n = set == kUsedKeys ? sizeof kUsedKeys / sizeof *kUsedKeys : sizeof kIgnoredKeys / sizeof *kIgnoredKeys;
-            for (size_t i = 0; i < n; i++) {
-                if (k == set[i]) known = true;
-                size_t d = edit_distance(k, set[i]);
-                if (d < best) { best = d; nearest = set[i]; }
-            }
-        }
+        bool known = std::find(all.begin(), all.end(), k) != all.end();
         if (known) continue;
-        std::string msg = c.path + ":" + std::to_string(line) + ": unknown key '" + k + "'" +
-                          (nearest.empty() ? std::string() : " (did you mean '" + nearest + "'?)");
+        std::string msg = c.path + ":" + std::to_string(line) + ": unknown key '" + k + "'" + did_you_mean(k, all);
         if (!lenient) throw Error(msg + "; --lenient reads the file anyway");
         if (warnings) warnings->push_back(msg + ": ignored (--lenient)");
     }

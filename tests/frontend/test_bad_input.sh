@@ -49,6 +49,21 @@ check calib_misspelled_covariance 1 "unknown key 'intrinsic_covarience' \(did yo
 { cat $CALIB; echo "mount_tilt_deg: 30"; } > "$T/dup.yaml"
 check calib_duplicate_key 1 "dup.yaml: field 'mount_tilt_deg': given twice \(lines [0-9]+ and [0-9]+\)" \
   -- "$T/detect" "$T/s.cylraw" $TABLE "$T/dup.yaml"
+# scene files: a misspelled key is an error naming where it is and the nearest known key
+RENDER=$(dirname "$CYL")/cyl-render
+"$RENDER" --write-scene "$T/scene.yaml" -q
+sed "s/^imaging:/imagng:/" "$T/scene.yaml" > "$T/scene_top.yaml"
+check scene_misspelled_section 1 "scene_top.yaml: \(top level\): unknown key 'imagng' \(did you mean 'imaging'\?\)" -- \
+  "$RENDER" -S "$T/scene_top.yaml" -n 1 -q -o "$T/r.cylraw"
+python3 - "$T/scene.yaml" "$T/scene_cyl.yaml" <<'PY'
+import sys
+lines = open(sys.argv[1]).read().split("\n")
+k = [i for i, l in enumerate(lines) if l.strip().startswith("diameter_m:")][2]   # the third cylinder
+lines[k] = lines[k].replace("diameter_m:", "diamter_m:")
+open(sys.argv[2], "w").write("\n".join(lines))
+PY
+check scene_misspelled_cylinder_key 1 "scene_cyl.yaml: cylinders\[2\]: unknown key 'diamter_m' \(did you mean 'diameter_m'\?\)" -- \
+  "$RENDER" -S "$T/scene_cyl.yaml" -n 1 -q -o "$T/r.cylraw"
 # frames of another size than the calibration's: an error naming both sizes, before any output
 check frame_size_mismatch 1 "paper_camera.yaml: calibrated for 768x576 px, but synthetic:2 gives 640x480 px" -- \
   "$CYL" detect synthetic:2 --calib calib_data/paper_camera.yaml --max-frames 2 --out "$T/good.jsonl" --quiet

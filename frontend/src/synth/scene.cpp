@@ -2,10 +2,13 @@
 // Scenes: the built-in default, scene files (cv::FileStorage YAML/JSON), the libcyl camera.
 #include "cylfe/synth.hpp"
 #include "cylfe/error.hpp"
+#include "cylfe/keys.hpp"
 
 #include <opencv2/core.hpp>
 
+#include <algorithm>
 #include <cerrno>
+#include <map>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -127,39 +130,79 @@ cyl_camera to_cyl_camera(const Scene &s) { return to_cyl_camera(s.camera, s.sigm
 
 namespace {
 
+// Reads scene-file fields and remembers, for every mapping it reads from, which keys it asked for;
+// check_unknown() then finds the keys of those mappings that nothing asked for (misspellings):
+// errors naming the mapping and the nearest key it knows.
 struct Reader {
     std::string path;
-    void num(const cv::FileNode &n, const char *key, double &v, double scale = 1.0) const
+    struct Asked {
+        cv::FileNode node;
+        std::string where;
+        std::vector<std::string> keys;
+    };
+    std::map<std::pair<size_t, size_t>, Asked> asked;   // by the node's (block, offset) in the file
+
+    cv::FileNode get(const cv::FileNode &n, const char *key)
     {
-        cv::FileNode f = n[key];
+        Asked &a = asked[{n.blockIdx, n.ofs}];
+        if (a.where.empty()) { a.node = n; a.where = "?"; }
+        a.keys.emplace_back(key);
+        return n[key];
+    }
+    void section(const cv::FileNode &n, const std::string &where)
+    {
+        Asked &a = asked[{n.blockIdx, n.ofs}];
+        a.node = n;
+        a.where = where;
+    }
+    // a nested mapping, named by its key
+    cv::FileNode sub(const cv::FileNode &n, const char *key)
+    {
+        cv::FileNode f = get(n, key);
+        if (f.isMap()) section(f, key);
+        return f;
+    }
+    void check_unknown() const
+    {
+        for (const auto &e : asked) {
+            const Asked &a = e.second;
+            if (!a.node.isMap()) continue;
+            for (const std::string &k : a.node.keys())
+                if (std::find(a.keys.begin(), a.keys.end(), k) == a.keys.end())
+                    throw Error(path + ": " + a.where + ": unknown key '" + k + "'" + did_you_mean(k, a.keys));
+        }
+    }
+    void num(const cv::FileNode &n, const char *key, double &v, double scale = 1.0)
+    {
+        cv::FileNode f = get(n, key);
         if (f.empty()) return;
         if (!f.isReal() && !f.isInt()) throw Error(path + ": field '" + key + "' must be a number");
         v = (double)f * scale;
     }
-    void num(const cv::FileNode &n, const char *key, uint32_t &v) const
+    void num(const cv::FileNode &n, const char *key, uint32_t &v)
     {
-        cv::FileNode f = n[key];
+        cv::FileNode f = get(n, key);
         if (f.empty()) return;
         if (!f.isInt() || (int)f < 0) throw Error(path + ": field '" + key + "' must be a non-negative integer");
         v = (uint32_t)(int)f;
     }
-    void str(const cv::FileNode &n, const char *key, std::string &v) const
+    void str(const cv::FileNode &n, const char *key, std::string &v)
     {
-        cv::FileNode f = n[key];
+        cv::FileNode f = get(n, key);
         if (f.empty()) return;
         if (!f.isString()) throw Error(path + ": field '" + key + "' must be a string");
         v = (std::string)f;
     }
-    void yuv(const cv::FileNode &n, const char *key, Yuv &c) const
+    void yuv(const cv::FileNode &n, const char *key, Yuv &c)
     {
-        cv::FileNode f = n[key];
+        cv::FileNode f = get(n, key);
         if (f.empty()) return;
         if (!f.isSeq() || f.size() != 3) throw Error(path + ": field '" + key + "' must be [Y, U, V]");
         c.y = (double)f[0]; c.u = (double)f[1]; c.v = (double)f[2];
     }
-    int32_t cls(const cv::FileNode &n, const std::vector<std::string> &classes) const
+    int32_t cls(const cv::FileNode &n, const std::vector<std::string> &classes)
     {
-        cv::FileNode f = n["class"];
+        cv::FileNode f = get(n, "class");
         if (f.empty()) return -1;
         if (f.isInt()) return (int32_t)(int)f;
         std::string name = (std::string)f;
@@ -185,24 +228,26 @@ Scene load_scene(const std::string &path)
     } catch (const cv::Exception &e) {
         throw Error(path + ": cannot parse scene file: " + e.what());
     }
-    Reader r{path};
+    Reader r;
+    r.path = path;
     Scene s = empty_scene();
     cv::FileNode root = fs.root();
+    r.section(root, "(top level)");
     r.str(root, "name", s.name);
-    if (!root["classes"].empty()) {
+    if (!r.get(root, "classes").empty()) {
         s.classes.clear();
-        for (const auto &it : root["classes"]) s.classes.push_back((std::string)it);
+        for (const auto &it : r.get(root, "classes")) s.classes.push_back((std::string)it);
     }
     r.num(root, "landmark_diameter_m", s.landmark_diameter_m);
     r.num(root, "landmark_height_m", s.landmark_height_m);
-    cv::FileNode n = root["room"];
+    cv::FileNode n = r.sub(root, "room");
     if (!n.empty()) {
         r.num(n, "x_min", s.room.x_min); r.num(n, "x_max", s.room.x_max);
         r.num(n, "y_min", s.room.y_min); r.num(n, "y_max", s.room.y_max);
         r.num(n, "wall_height_m", s.room.wall_height_m); r.num(n, "floor_texture", s.room.floor_texture);
         r.yuv(n, "floor", s.room.floor); r.yuv(n, "wall", s.room.wall); r.yuv(n, "ceiling", s.room.ceiling);
     }
-    n = root["camera"];
+    n = r.sub(root, "camera");
     if (!n.empty()) {
         CameraModel &c = s.camera;
         r.num(n, "width", c.width); r.num(n, "height", c.height);
@@ -211,7 +256,7 @@ Scene load_scene(const std::string &path)
         r.num(n, "tilt_deg", c.tilt_rad, kDeg); r.num(n, "yaw_deg", c.yaw_rad, kDeg);
         r.num(n, "height_floor_m", c.height_floor_m); r.num(n, "offset_m", c.offset_m);
     }
-    n = root["sigmas"];
+    n = r.sub(root, "sigmas");
     if (!n.empty()) {
         CameraSigmas &g = s.sigmas;
         r.num(n, "fx", g.fx); r.num(n, "fy", g.fy); r.num(n, "cx", g.cx); r.num(n, "cy", g.cy);
@@ -219,7 +264,7 @@ Scene load_scene(const std::string &path)
         r.num(n, "tilt_deg", g.tilt_rad, kDeg); r.num(n, "yaw_deg", g.yaw_rad, kDeg);
         r.num(n, "height_m", g.height_m); r.num(n, "offset_m", g.offset_m);
     }
-    n = root["imaging"];
+    n = r.sub(root, "imaging");
     if (!n.empty()) {
         Imaging &im = s.imaging;
         r.num(n, "samples", im.samples);
@@ -230,7 +275,7 @@ Scene load_scene(const std::string &path)
         r.num(n, "ambient", im.ambient); r.num(n, "diffuse", im.diffuse);
         r.num(n, "light_az_deg", im.light_az_rad, kDeg); r.num(n, "light_el_deg", im.light_el_rad, kDeg);
     }
-    n = root["trajectory"];
+    n = r.sub(root, "trajectory");
     if (!n.empty()) {
         TrajectoryParams &t = s.trajectory;
         r.str(n, "type", t.type);
@@ -240,14 +285,16 @@ Scene load_scene(const std::string &path)
         r.num(n, "a_m", t.a_m); r.num(n, "b_m", t.b_m); r.num(n, "speed_mps", t.speed_mps);
         r.num(n, "fps", t.fps); r.num(n, "phase0", t.phase0);
     }
-    n = root["odometry"];
+    n = r.sub(root, "odometry");
     if (!n.empty()) {
         OdometryNoise &o = s.odometry;
         r.num(n, "k_long", o.k_long); r.num(n, "k_lat", o.k_lat); r.num(n, "k_rot", o.k_rot);
         r.num(n, "k_rot_d", o.k_rot_d); r.num(n, "min_xy", o.min_xy); r.num(n, "min_theta", o.min_theta);
     }
     uint32_t next_id = 0;
-    for (const auto &it : root["cylinders"]) {
+    size_t i_cylinders = 0;
+    for (const auto &it : r.get(root, "cylinders")) {
+        r.section(it, "cylinders[" + std::to_string(i_cylinders++) + "]");
         Cylinder c;
         c.diameter_m = s.landmark_diameter_m;
         c.height_m = s.landmark_height_m;
@@ -264,7 +311,9 @@ Scene load_scene(const std::string &path)
         if (c.diameter_m <= 0 || c.height_m <= 0) throw Error(path + ": cylinder with non-positive size");
         s.cylinders.push_back(c);
     }
-    for (const auto &it : root["boxes"]) {
+    size_t i_boxes = 0;
+    for (const auto &it : r.get(root, "boxes")) {
+        r.section(it, "boxes[" + std::to_string(i_boxes++) + "]");
         Box b;
         b.cls = r.cls(it, s.classes);
         r.num(it, "x_m", b.x_m); r.num(it, "y_m", b.y_m); r.num(it, "yaw_deg", b.yaw_rad, kDeg);
@@ -272,7 +321,9 @@ Scene load_scene(const std::string &path)
         r.yuv(it, "colour", b.colour);
         s.boxes.push_back(b);
     }
-    for (const auto &it : root["patches"]) {
+    size_t i_patches = 0;
+    for (const auto &it : r.get(root, "patches")) {
+        r.section(it, "patches[" + std::to_string(i_patches++) + "]");
         FloorPatch p;
         p.cls = r.cls(it, s.classes);
         r.num(it, "x_m", p.x_m); r.num(it, "y_m", p.y_m); r.num(it, "yaw_deg", p.yaw_rad, kDeg);
@@ -280,6 +331,7 @@ Scene load_scene(const std::string &path)
         r.yuv(it, "colour", p.colour);
         s.patches.push_back(p);
     }
+    r.check_unknown();
     return s;
 }
 
