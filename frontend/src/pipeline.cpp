@@ -58,12 +58,10 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
     cyl_status s = cyl_segment(&table_, &img, &config_.segment, &seg_);
     check(s, "segmentation");
     truncated_ = s == CYL_TRUNCATED;
-    // The image estimator reads the frame and the table; it must drop runs and merge as the
-    // segmentation did.
+    // The image estimator reads the frame and the table (and the segmentation's own parameters,
+    // recorded in seg_).
     config_.observe.image = &img;
     config_.observe.table = &table_;
-    config_.observe.image_noise.min_run_px = config_.segment.min_run_px;
-    config_.observe.image_noise.merge_gap_px = config_.segment.cls[0].merge_gap_px;
     size_t need = cyl_observe_work_size(&seg_, &config_.observe);
     if (obs_work_.size() < need) obs_work_.resize(need);  // grows to the largest frame seen, once
     obs_.resize(config_.max_observations);

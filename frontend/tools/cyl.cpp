@@ -151,9 +151,9 @@ Args parse(int argc, char **argv)
         else if (s == "--overlay") {
             a.overlay = val(s);
             const std::string &o = a.overlay;
-            size_t slash = o.find_last_of('/'), dot = o.find_last_of('.');
-            bool has_ext = dot != std::string::npos && (slash == std::string::npos || dot > slash) && dot + 1 < o.size() &&
-                           dot > (slash == std::string::npos ? 0 : slash + 1);
+            const size_t slash = o.find_last_of('/'), dot = o.find_last_of('.');
+            const size_t base = slash == std::string::npos ? 0 : slash + 1;   // the file name's first char
+            const bool has_ext = dot != std::string::npos && dot > base && dot + 1 < o.size();
             if (has_ext && o.compare(dot, std::string::npos, ".avi") != 0)
                 usage_error("--overlay " + o + ": the video is written as MJPG in an .avi file; give FILE.avi, or a "
                             "folder for one PNG per frame");

@@ -67,17 +67,6 @@ bool parse_u64(const char *s, uint64_t &v)
     return true;
 }
 
-void write_file(const std::string &path, const uint8_t *data, size_t n)
-{
-    cylfe::OutputPlan plan = cylfe::plan_output(path);
-    FILE *f = std::fopen(plan.write_to.c_str(), "wb");
-    if (!f) throw Error(path + ": cannot open for writing: " + std::strerror(errno));
-    bool ok = std::fwrite(data, 1, n, f) == n;
-    ok = (std::fclose(f) == 0) && ok;
-    if (!ok) throw Error(path + ": write failed");
-    cylfe::finish_output(plan);
-}
-
 } // namespace
 
 int main(int argc, char **argv)
@@ -141,7 +130,7 @@ int main(int argc, char **argv)
             std::vector<uint8_t> buf(CYL_TABLE_FILE_SIZE);
             size_t n = 0;
             check(cyl_colortable_save(&t, buf.data(), buf.size(), &n), "cyl_colortable_save");
-            write_file(write_table, buf.data(), n);
+            cylfe::write_file_atomic(write_table, std::string(buf.begin(), buf.begin() + (std::ptrdiff_t)n));
             if (!quiet) std::fputs(log.c_str(), stderr);
             std::fprintf(stderr, "cyl-render: wrote colour table %s (%zu classes)\n", write_table.c_str(),
                          scene.classes.size());

@@ -45,8 +45,6 @@ cyl_noise_image_params cyl_noise_image_params_default(void)
     p.min_sigma = 0.1;
     p.band_px = 4u;
     p.draws = 32u;
-    p.min_run_px = 3u;
-    p.merge_gap_px = 3;
     return p;
 }
 
@@ -523,7 +521,7 @@ cyl_status cyl_noise_blob_image(const cyl_segmentation *seg, const cyl_blob *b, 
     cyl_status st;
     if (!seg || !b || !img || !t || !p || !out) return CYL_ERR_ARG;
     if (p->band_px < 1u || p->band_px > IMG_MAX_BAND || p->draws < 2u || p->draws > IMG_MAX_DRAWS ||
-        p->min_run_px < 1u || !(p->fallback_sigma >= 0.0) || !(p->min_sigma >= 0.0) ||
+        !(p->fallback_sigma >= 0.0) || !(p->min_sigma >= 0.0) ||
         !(p->sigma_y >= 0.0) || !(p->sigma_u >= 0.0) || !(p->sigma_v >= 0.0) ||
         !(p->fallback_sigma < 256.0) || !(p->sigma_y < 256.0) || !(p->sigma_u < 256.0) ||
         !(p->sigma_v < 256.0) || !(p->min_sigma < 256.0))
@@ -555,8 +553,10 @@ cyl_status cyl_noise_blob_image(const cyl_segmentation *seg, const cyl_blob *b, 
     c.sub_v = img->format == CYL_FMT_NV12 || img->format == CYL_FMT_I420;
     c.draws = p->draws;
     c.band = p->band_px;
-    c.min_run = p->min_run_px;
-    c.merge_gap = p->merge_gap_px < 0 ? -1 : (int32_t)((uint32_t)p->merge_gap_px / c.sx);
+    /* the segmentation's own run filter and this class's merging (a hand-made segmentation that
+     * never went through cyl_segment has 0: every run kept) */
+    c.min_run = seg->min_run_px ? seg->min_run_px : 1u;
+    c.merge_gap = seg->merge_gap_px[b->cls] < 0 ? -1 : (int32_t)((uint32_t)seg->merge_gap_px[b->cls] / c.sx);
     c.bx0 = (int32_t)(b->x0 / c.sx);
     c.bx1 = (int32_t)(b->x1 / c.sx);
     c.by0 = (int32_t)(b->y0 / c.sy);

@@ -30,12 +30,14 @@ size_t cyl_observe_work_size(const cyl_segmentation *seg, const cyl_observe_para
 }
 
 /* The silhouette's geometric bias (cyl/silhouette.h) taken out of the measurement point: the
- * offset at the landmark's position, which comes from the point itself, so twice (the second
- * pass moves the offset by < 0.01 px in the synthetic scene). The offset's variance is added to
- * the centroid's. On any failure the uncorrected result stays. */
+ * offset at the landmark's position, which comes from the point itself, so twice (on the synthetic
+ * camera at 0.8-4 m one pass leaves the point up to 0.081 px from the image of the centre, two
+ * 0.003 px). The offset's variance is added to the centroid's. On any failure the uncorrected
+ * result stays. */
 static void correct_silhouette(cyl_observation *o, const cyl_camera *cam, const cyl_observe_params *p,
                                const cyl_landmark_size *size, cyl_rb_result *rb)
 {
+    const double var_cu = o->var_u_px2, var_cv = o->var_v_px2;   /* the centroid's own */
     int it;
     for (it = 0; it < 2; it++) {
         cyl_silhouette_bias sb;
@@ -44,8 +46,8 @@ static void correct_silhouette(cyl_observation *o, const cyl_camera *cam, const 
         if (cyl_silhouette_bias_at(cam, rb->x_m, rb->y_m, size, p->silhouette_rel_sigma, p->silhouette_sigma_px, &sb) != CYL_OK) return;
         u = o->centroid_u_px - sb.du_px;
         v = o->centroid_v_px - sb.dv_px;
-        vu = (o->var_u_px2 - o->bias_var_u_px2) + sb.var_u_px2;
-        vv = (o->var_v_px2 - o->bias_var_v_px2) + sb.var_v_px2;
+        vu = var_cu + sb.var_u_px2;
+        vv = var_cv + sb.var_v_px2;
         if (cyl_rb_compute(cam, p->model, u, v, vu, vv, 0.0, &r2) != CYL_OK) return;
         *rb = r2;
         o->u_px = u;

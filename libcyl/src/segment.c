@@ -87,6 +87,11 @@ cyl_status cyl_segmentation_init(cyl_segmentation *seg, void *mem, size_t mem_si
     seg->work_size = ALIGN_UP((size_t)max_blobs * sizeof(blob_acc), 16u);
     seg->max_runs = max_runs;
     seg->max_blobs = max_blobs;
+    seg->min_run_px = 1u;
+    {
+        unsigned k;
+        for (k = 0; k < CYL_MAX_CLASSES; k++) seg->merge_gap_px[k] = -1;
+    }
     return CYL_OK;
 }
 
@@ -461,7 +466,12 @@ cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
     seg->y_last = r.y + ((r.height - 1u) / ys) * ys;
     seg->frame_width = img->width;
     seg->frame_height = img->height;
-    for (k = 0; k < CYL_MAX_CLASSES; k++) { seg->class_first[k] = 0; seg->class_count[k] = 0; }
+    seg->min_run_px = p->min_run_px;
+    for (k = 0; k < CYL_MAX_CLASSES; k++) {
+        seg->class_first[k] = 0;
+        seg->class_count[k] = 0;
+        seg->merge_gap_px[k] = p->cls[k].merge_gap_px;
+    }
 
     /* 1. classify + run-length encode, connecting each row to the previous one */
     runs = seg->runs;

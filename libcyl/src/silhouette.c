@@ -5,19 +5,22 @@
 #include <math.h>
 
 #define NPTS (2 * CYL_SILHOUETTE_POINTS)
-#define EDGE_STEPS 8
+#define PIECE_PX 4.0  /* longest straight piece of the outline taken through the lens, px */
+
+/* The camera's mount, its sines and cosines computed once per call. */
+typedef struct mount {
+    double offset_m, height_m, cy, sy, ct, st;
+} mount;
 
 /* A point at robot-frame (x, y) and z_up above the centroid plane -> undistorted normalised image
  * coordinates (the frames of cyl_rb_project). Returns 0 if the point is not in front. */
-static int to_normalised(const cyl_camera *cam, double x_m, double y_m, double z_up_m, double *xn, double *yn)
+static int to_normalised(const mount *m, double x_m, double y_m, double z_up_m, double *xn, double *yn)
 {
-    const double dx = x_m - cam->offset_m, dy = y_m;
-    const double cy = cos(cam->yaw_rad), sy = sin(cam->yaw_rad);
-    const double ct = cos(cam->tilt_rad), st = sin(cam->tilt_rad);
-    const double Xl = cy * dx + sy * dy;   /* level frame: forward, right, down */
-    const double Yl = sy * dx - cy * dy;
-    const double Zl = cam->height_m - z_up_m;
-    const double Xc = Yl, Yc = -st * Xl + ct * Zl, Zc = ct * Xl + st * Zl;
+    const double dx = x_m - m->offset_m, dy = y_m;
+    const double Xl = m->cy * dx + m->sy * dy;   /* level frame: forward, right, down */
+    const double Yl = m->sy * dx - m->cy * dy;
+    const double Zl = m->height_m - z_up_m;
+    const double Xc = Yl, Yc = -m->st * Xl + m->ct * Zl, Zc = m->ct * Xl + m->st * Zl;
     if (!(Zc > 1e-9)) return 0;
     *xn = Xc / Zc;
     *yn = Yc / Zc;
@@ -34,6 +37,7 @@ cyl_status cyl_silhouette_bias_at(const cyl_camera *cam, double x_m, double y_m,
 {
     double p[NPTS][2], hull[NPTS + 1][2];
     double r, xc, yc, a2 = 0.0, sx = 0.0, sy = 0.0, uc, vc, us, vs;
+    mount mt;
     int i, j, k = 0, lower;
     cyl_status s;
     if (!cam || !size || !out || !isfinite(x_m) || !isfinite(y_m) || !(rel_sigma >= 0.0) || !isfinite(rel_sigma) ||
@@ -48,14 +52,25 @@ cyl_status cyl_silhouette_bias_at(const cyl_camera *cam, double x_m, double y_m,
      * 0.3% smaller) */
     r = 0.5 * size->diameter_m *
         sqrt(6.283185307179586 / (CYL_SILHOUETTE_POINTS * sin(6.283185307179586 / CYL_SILHOUETTE_POINTS)));
-    for (i = 0; i < CYL_SILHOUETTE_POINTS; i++) {
-        const double a = 6.283185307179586 * (double)i / CYL_SILHOUETTE_POINTS;
-        const double px = x_m + r * cos(a), py = y_m + r * sin(a);
-        if (!to_normalised(cam, px, py, 0.5 * size->height_m, &p[2 * i][0], &p[2 * i][1]) ||
-            !to_normalised(cam, px, py, -0.5 * size->height_m, &p[2 * i + 1][0], &p[2 * i + 1][1]))
-            return CYL_ERR_NO_RANGE;
+    mt.offset_m = cam->offset_m;
+    mt.height_m = cam->height_m;
+    mt.cy = cos(cam->yaw_rad);
+    mt.sy = sin(cam->yaw_rad);
+    mt.ct = cos(cam->tilt_rad);
+    mt.st = sin(cam->tilt_rad);
+    {   /* the circle's points by rotation: two sines per call instead of two per point */
+        const double da = 6.283185307179586 / CYL_SILHOUETTE_POINTS, cd = cos(da), sd = sin(da);
+        double ca = 1.0, sa = 0.0;
+        for (i = 0; i < CYL_SILHOUETTE_POINTS; i++) {
+            const double px = x_m + r * ca, py = y_m + r * sa, t = ca * cd - sa * sd;
+            if (!to_normalised(&mt, px, py, 0.5 * size->height_m, &p[2 * i][0], &p[2 * i][1]) ||
+                !to_normalised(&mt, px, py, -0.5 * size->height_m, &p[2 * i + 1][0], &p[2 * i + 1][1]))
+                return CYL_ERR_NO_RANGE;
+            sa = sa * cd + ca * sd;
+            ca = t;
+        }
     }
-    if (!to_normalised(cam, x_m, y_m, 0.0, &xc, &yc)) return CYL_ERR_NO_RANGE;
+    if (!to_normalised(&mt, x_m, y_m, 0.0, &xc, &yc)) return CYL_ERR_NO_RANGE;
     /* sort by (x, y): insertion sort, NPTS is small */
     for (i = 1; i < NPTS; i++) {
         double t0 = p[i][0], t1 = p[i][1];
@@ -84,20 +99,29 @@ cyl_status cyl_silhouette_bias_at(const cyl_camera *cam, double x_m, double y_m,
     k--;  /* the last point repeats the first */
     if (k < 3) return CYL_ERR_NO_RANGE;
     /* Area centroid in the image (shoelace), with the lens: each hull edge, straight in
-     * normalised coordinates, is cut into EDGE_STEPS pieces whose ends are projected through
-     * the lens model, so a large blob's distortion moves its centroid as it does in the image. */
-    for (i = 0; i < k; i++) {
-        const double *a = hull[i], *b = hull[(i + 1) % k];
-        int m;
-        for (m = 0; m < EDGE_STEPS; m++) {
-            double u0, v0, u1, v1, c;
-            const double t0 = (double)m / EDGE_STEPS, t1 = (double)(m + 1) / EDGE_STEPS;
-            cyl_camera_project(cam, a[0] + t0 * (b[0] - a[0]), a[1] + t0 * (b[1] - a[1]), &u0, &v0);
-            cyl_camera_project(cam, a[0] + t1 * (b[0] - a[0]), a[1] + t1 * (b[1] - a[1]), &u1, &v1);
-            c = u0 * v1 - u1 * v0;
-            a2 += c;
-            sx += (u0 + u1) * c;
-            sy += (v0 + v1) * c;
+     * normalised coordinates, is cut into pieces of at most PIECE_PX px whose ends are projected
+     * through the lens model (each point once), so a large blob's distortion moves its centroid as
+     * it does in the image. */
+    {
+        double u0, v0;
+        cyl_camera_project(cam, hull[0][0], hull[0][1], &u0, &v0);
+        for (i = 0; i < k; i++) {
+            const double *a = hull[i], *b = hull[(i + 1) % k];
+            const double ex = (b[0] - a[0]) * cam->fx_px, ey = (b[1] - a[1]) * cam->fy_px;
+            const double len_px = sqrt(ex * ex + ey * ey);
+            const int pieces = 1 + (int)(len_px / PIECE_PX);
+            int m;
+            for (m = 1; m <= pieces; m++) {
+                double u1, v1, c;
+                const double t = (double)m / pieces;
+                cyl_camera_project(cam, a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), &u1, &v1);
+                c = u0 * v1 - u1 * v0;
+                a2 += c;
+                sx += (u0 + u1) * c;
+                sy += (v0 + v1) * c;
+                u0 = u1;
+                v0 = v1;
+            }
         }
     }
     if (!(fabs(a2) > 0.0)) return CYL_ERR_NO_RANGE;

@@ -104,8 +104,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     op.table = &t;
     op.image_noise.band_px = 1 + take(&data, &size, 4);
     op.image_noise.draws = 2 + take(&data, &size, 8);
-    op.image_noise.min_run_px = p.min_run_px;
-    op.image_noise.merge_gap_px = p.cls[0].merge_gap_px;
     op.model = (cyl_geom_model)take(&data, &size, 2);
     if (cyl_observe_work_size(&seg, &op) > sizeof work) return 0;
     s = cyl_observe(&seg, &cam, &op, work, sizeof work, obs, 64, &n_obs);

@@ -88,14 +88,6 @@ static const cyl_blob *segment(fixture *f)
     return &f->seg.blobs[f->seg.class_first[0]];
 }
 
-static cyl_noise_image_params params(const fixture *f)
-{
-    cyl_noise_image_params q = cyl_noise_image_params_default();
-    q.min_run_px = f->p.min_run_px;
-    q.merge_gap_px = -1;
-    return q;
-}
-
 /* Noise-free frame, hard edge: every edge cell is 16 or more levels of U from the threshold, so no draw
  * of the floor noise (0.1 levels) flips it: the variance is exactly 0 and the centroid that of
  * the segmentation. */
@@ -111,7 +103,7 @@ static void test_noise_free_hard_edge_is_certain(void **state)
     draw(&f, 80.3, 60.6, 20, 0, 0, NULL);
     b = segment(&f);
     assert_non_null(b);
-    q = params(&f);
+    q = cyl_noise_image_params_default();
     assert_int_equal(cyl_noise_blob_image(&f.seg, b, &f.img, &f.table, &q, &o), CYL_OK);
     assert_int_equal(cyl_noise_blob(&f.seg, b, CYL_NOISE_LOCAL, work, sizeof work, &loc), CYL_OK);
     assert_true(o.var_x_px2 < 1e-20 && o.var_y_px2 < 1e-20);  /* 0 but for the moments' round-off */
@@ -142,7 +134,7 @@ static void test_noise_estimate_follows_frame(void **state)
         draw(&f, 80.0, 60.0, 30, 0, sig[i], &rng);
         b = segment(&f);
         assert_non_null(b);
-        q = params(&f);
+        q = cyl_noise_image_params_default();
         assert_int_equal(cyl_noise_blob_image(&f.seg, b, &f.img, &f.table, &q, &o), CYL_OK);
         assert_true(fabs(o.sigma_y / expect - 1) < 0.15);
         assert_true(fabs(o.sigma_u / expect - 1) < 0.15);
@@ -176,7 +168,7 @@ static void test_monte_carlo_matches_resegmentation(void **state)
         double vx, vy, rx, ry;
         int k, n = 0;
         fx_open(&f);
-        q = params(&f);
+        q = cyl_noise_image_params_default();
         test_rng_seed(&rng, 1000 + i);
         for (k = 0; k < frames; k++) {
             cyl_centroid_noise o, loc;
@@ -218,7 +210,7 @@ static void test_bad_arguments(void **state)
     draw(&f, 80, 60, 20, 0, 0, NULL);
     b = segment(&f);
     assert_non_null(b);
-    q = params(&f);
+    q = cyl_noise_image_params_default();
     assert_int_equal(cyl_noise_blob_image(NULL, b, &f.img, &f.table, &q, &o), CYL_ERR_ARG);
     assert_int_equal(cyl_noise_blob_image(&f.seg, NULL, &f.img, &f.table, &q, &o), CYL_ERR_ARG);
     assert_int_equal(cyl_noise_blob_image(&f.seg, b, NULL, &f.table, &q, &o), CYL_ERR_ARG);
@@ -227,15 +219,15 @@ static void test_bad_arguments(void **state)
     assert_int_equal(cyl_noise_blob_image(&f.seg, b, &f.img, &f.table, &q, NULL), CYL_ERR_ARG);
     q.band_px = 0;
     assert_int_equal(cyl_noise_blob_image(&f.seg, b, &f.img, &f.table, &q, &o), CYL_ERR_ARG);
-    q = params(&f); q.band_px = 5;
+    q = cyl_noise_image_params_default(); q.band_px = 5;
     assert_int_equal(cyl_noise_blob_image(&f.seg, b, &f.img, &f.table, &q, &o), CYL_ERR_ARG);
-    q = params(&f); q.draws = 1;
+    q = cyl_noise_image_params_default(); q.draws = 1;
     assert_int_equal(cyl_noise_blob_image(&f.seg, b, &f.img, &f.table, &q, &o), CYL_ERR_ARG);
-    q = params(&f); q.draws = 65;
+    q = cyl_noise_image_params_default(); q.draws = 65;
     assert_int_equal(cyl_noise_blob_image(&f.seg, b, &f.img, &f.table, &q, &o), CYL_ERR_ARG);
-    q = params(&f); q.sigma_y = -1;
+    q = cyl_noise_image_params_default(); q.sigma_y = -1;
     assert_int_equal(cyl_noise_blob_image(&f.seg, b, &f.img, &f.table, &q, &o), CYL_ERR_ARG);
-    q = params(&f); q.sigma_u = NAN;
+    q = cyl_noise_image_params_default(); q.sigma_u = NAN;
     assert_int_equal(cyl_noise_blob_image(&f.seg, b, &f.img, &f.table, &q, &o), CYL_ERR_ARG);
     free(f.mem);
 }

@@ -523,6 +523,24 @@ static void test_deterministic(void **state)
     fx_close(&f);
 }
 
+/* The segmentation records the run filter and each class's merge gap it used (the image
+ * estimator redoes both); cyl_segmentation_init starts from "keep every run, no merging". */
+static void test_records_its_parameters(void **state)
+{
+    fixture f;
+    (void)state;
+    fx_open(&f, 64, 48, 512, 16);
+    assert_int_equal(f.seg.min_run_px, 1);
+    assert_int_equal(f.seg.merge_gap_px[3], -1);
+    f.p.min_run_px = 4;
+    f.p.cls[1].merge_gap_px = 7;
+    assert_int_equal(fx_run(&f, CYL_FMT_YUYV, 0), CYL_OK);
+    assert_int_equal(f.seg.min_run_px, 4);
+    assert_int_equal(f.seg.merge_gap_px[1], 7);
+    assert_int_equal(f.seg.merge_gap_px[0], -1);
+    fx_close(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -538,6 +556,7 @@ int main(void)
         cmocka_unit_test(test_roi_and_step),
         cmocka_unit_test(test_capacity_truncation),
         cmocka_unit_test(test_bad_arguments),
+        cmocka_unit_test(test_records_its_parameters),
         cmocka_unit_test(test_bruteforce_random),
         cmocka_unit_test(test_deterministic),
     };

@@ -91,7 +91,6 @@ struct RbConfig {
     bool calibration_error = true;  // false: pixel-noise-only (estimator camera exact, sigmas 0)
     uint64_t seed = 7;
     cyl_noise_estimator estimator = CYL_NOISE_IMAGE;  // the frontend's default
-    double silhouette_rel_sigma = 0.25;               // cyl_observe_params.silhouette_rel_sigma
 };
 std::vector<RbSample> run_range_bearing(const Scene &base, const cyl_colortable &t, const RbConfig &c);
 

@@ -124,8 +124,6 @@ void Detect::segment(const uint8_t *yuyv)
     check(cyl_segment(t_, &img_, &seg_params, &seg_), "cyl_segment");
     obs_params.image = &img_;
     obs_params.table = t_;
-    obs_params.image_noise.min_run_px = seg_params.min_run_px;
-    obs_params.image_noise.merge_gap_px = seg_params.cls[0].merge_gap_px;
 }
 
 const std::vector<cyl_observation> &Detect::observe(const cyl_camera &cam, cyl_noise_estimator est)
@@ -288,7 +286,6 @@ std::vector<RbSample> run_range_bearing(const Scene &base, const cyl_colortable 
         double gain = ren.frame_gain(cfg.seed, run, run * 3.7);
         ren.render_yuyv(robot, gain, mix_seed(cfg.seed, run, 0xF00D), frame);
         det.segment(frame.data());
-        det.obs_params.silhouette_rel_sigma = cfg.silhouette_rel_sigma;
         const std::vector<cyl_observation> &obs = det.observe(cam, cfg.estimator);
         for (size_t k = 0; k < sc.cylinders.size(); k++) {
             const Cylinder &c = sc.cylinders[k];

@@ -234,9 +234,10 @@ Scene load_scene(const std::string &path)
     cv::FileNode root = fs.root();
     r.section(root, "(top level)");
     r.str(root, "name", s.name);
-    if (!r.get(root, "classes").empty()) {
+    const cv::FileNode classes = r.get(root, "classes");
+    if (!classes.empty()) {
         s.classes.clear();
-        for (const auto &it : r.get(root, "classes")) s.classes.push_back((std::string)it);
+        for (const auto &it : classes) s.classes.push_back((std::string)it);
     }
     r.num(root, "landmark_diameter_m", s.landmark_diameter_m);
     r.num(root, "landmark_height_m", s.landmark_height_m);

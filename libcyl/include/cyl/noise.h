@@ -92,9 +92,10 @@ cyl_status cyl_noise_blob(const cyl_segmentation *seg, const cyl_blob *b, cyl_no
  *      cell is re-classified `draws` times with the observed value plus Gaussian noise of that std
  *      (deterministic draws from a hash of the cell; chroma draws shared by the pixels that share a
  *      chroma sample), through the same colour table and class precedence as cyl_segment;
- *   3. per row, each draw is run-length encoded again as cyl_segment would (runs shorter than
- *      min_run_px dropped; a run counts if it touches the blob's runs in this or a neighbouring
- *      row, or lies within the class's merge gap of the blob's box), giving the row's moments
+ *   3. per row, each draw is run-length encoded again as cyl_segment did (runs shorter than the
+ *      segmentation's min_run_px dropped; a run counts if it touches the blob's runs in this or a
+ *      neighbouring row, or lies within the class's merge_gap_px of the blob's box: both read from
+ *      seg, which records them), giving the row's moments
  *      sum (x - m_x) and sum (y - m_y);
  *   4. VAR(m_x) = sum over rows of the draws' variance of the row moment / n^2 (rows that share
  *      chroma samples, as in 4:2:0, are summed before the variance), likewise VAR(m_y).
@@ -110,12 +111,9 @@ typedef struct cyl_noise_image_params {
                                 estimate (default 2.5) */
     double min_sigma;        /* floor on every std used for the draws, levels (default 0.1) */
     uint32_t band_px;        /* half-width of the simulated band around the edges, grid cells, 1..4
-                                (default 4: chosen from 1..4 on the tuning sweep, seed 1) */
+                                (default 4: set on the tuning seed 1 of the imaging sweep,
+                                docs/uncertainty.md; no held-out seed was used) */
     uint32_t draws;          /* simulated frames, 2..64 (default 32) */
-    uint32_t min_run_px;     /* the segmentation's min_run_px (default 3) */
-    int32_t merge_gap_px;    /* the class's merge_gap_px (default 3; < 0: no merging): a simulated run
-                                within this gap of the blob's box joins it, as cyl_segment's merging
-                                would; otherwise only runs touching the blob count */
 } cyl_noise_image_params;
 
 /* The defaults above. */

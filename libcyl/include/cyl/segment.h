@@ -105,6 +105,9 @@ typedef struct cyl_segmentation {
     uint32_t x_last, y_last;  /* last sampled column and row, px */
     uint16_t x_step, y_step;  /* grid steps used */
     uint32_t frame_width, frame_height; /* size of the frame segmented, px */
+    uint16_t min_run_px;      /* the params' min_run_px these runs were made with (1 after init) */
+    int32_t merge_gap_px[CYL_MAX_CLASSES]; /* each class's merge_gap_px used, px (< 0: no
+                                 merging; -1 after init): what cyl_noise_blob_image() redoes */
     uint32_t truncated;       /* 0, or CYL_SEG_RUNS_FULL | CYL_SEG_BLOBS_FULL */
     void *work;               /* internal workspace (inside the caller's block) */
     size_t work_size;

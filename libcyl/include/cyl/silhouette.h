@@ -12,7 +12,7 @@
  * tilt, yaw, height, offset), the landmark's size and its position. A cylinder is convex, so its
  * silhouette is the convex hull of the images of its top and bottom circles (exactly so in the
  * pinhole's normalised coordinates, where the hull is found); the hull's outline is then taken
- * through the lens model (each edge in 8 pieces) and the area centroid computed in pixels, so a
+ * through the lens model (in pieces of at most 4 px) and the area centroid computed in pixels, so a
  * tall blob low in a barrel-distorted image has its centroid pulled up as in the image.
  * The offset is returned with a variance for what the model does not know: (rel_sigma x offset)^2
  * for the landmark's true size and shape, plus sigma_px^2 for what is not geometry (shading, the
