@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 extern "C" {
@@ -73,9 +74,29 @@ inline void make_table(cyl_colortable *table)
 }
 
 // The benchmarks' shared set-up: nframes distinct frames, the table, and segmentation memory.
+// The same classes in the 3-D table's form, as learning leaves them (cyl/colorlearn.h): a cell
+// belongs to a class when its centre colour does; uv is the cells' projection and y all ones,
+// so segmentation uses the 3-D lookup alone (CYL_LOOKUP_YUV).
+inline void to_3d_table(const cyl_colortable &box, cyl_colortable *t)
+{
+    *t = box;
+    std::memset(t->uv, 0, sizeof t->uv);
+    for (unsigned yc = 0; yc < CYL_YUV_NY; yc++)
+        for (unsigned uc = 0; uc < CYL_YUV_NC; uc++)
+            for (unsigned vc = 0; vc < CYL_YUV_NC; vc++) {
+                const unsigned Y = yc * 8 + 4, U = uc * 4 + 2, V = vc * 4 + 2;
+                const cyl_mask m = (cyl_mask)(box.uv[U][V] & box.y[Y]);
+                t->yuv[yc][uc][vc] = m;
+                for (unsigned du = 0; du < 4; du++)
+                    for (unsigned dv = 0; dv < 4; dv++) t->uv[uc * 4 + du][vc * 4 + dv] |= m;
+            }
+    std::memset(t->y, 0xFF, sizeof t->y);
+    cyl_colortable_refresh(t);
+}
+
 struct Setup {
     std::vector<std::vector<uint8_t>> frames;
-    cyl_colortable table;
+    cyl_colortable table, table3d;
     cyl_segment_params params = cyl_segment_params_default();
     std::vector<uint8_t> mem;
     cyl_segmentation seg{};
@@ -83,6 +104,7 @@ struct Setup {
     {
         for (int i = 0; i < nframes; i++) frames.push_back(make_frame(1000 + (uint64_t)i));
         make_table(&table);
+        to_3d_table(table, &table3d);
         mem.resize(cyl_segment_mem_size(max_runs, max_blobs));
         cyl_segmentation_init(&seg, mem.data(), mem.size(), max_runs, max_blobs);
     }

@@ -6,7 +6,8 @@
 // in one run. Prints a table and, last, a JSON line. Not a test.
 //
 //   bench_segment [--iterations N] [--frames F]       timing (medians)
-//   bench_segment --callgrind K                       only libcyl, K frames (for valgrind)
+//   bench_segment --callgrind K [--3d]                only libcyl, K frames (for valgrind);
+//                                                     --3d: with the learned-form (3-D) table
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -30,22 +31,23 @@ using namespace bench;
 
 int main(int argc, char **argv)
 {
-    int iterations = 1500, nframes = 16, callgrind = 0;
+    int iterations = 1500, nframes = 16, callgrind = 0, use3d = 0;
     for (int i = 1; i < argc; i++) {
         std::string a = argv[i];
         if (a == "--help" || a == "-h") {
-            std::printf("usage: bench_segment [--iterations N] [--frames F] [--callgrind K]\n");
+            std::printf("usage: bench_segment [--iterations N] [--frames F] [--callgrind K [--3d]]\n");
             return 0;
         } else if (a == "--iterations" && i + 1 < argc) iterations = std::atoi(argv[++i]);
         else if (a == "--frames" && i + 1 < argc) nframes = std::atoi(argv[++i]);
         else if (a == "--callgrind" && i + 1 < argc) callgrind = std::atoi(argv[++i]);
+        else if (a == "--3d") use3d = 1;
         else { std::fprintf(stderr, "bench_segment: unknown argument '%s' (see --help)\n", a.c_str()); return 2; }
     }
     if (iterations < 1 || nframes < 1) { std::fprintf(stderr, "bench_segment: counts must be >= 1\n"); return 2; }
 
-    static Setup set(nframes);  // static: the table is 66 KB
+    static Setup set(nframes);  // static: the tables are 193 KiB each
     const std::vector<std::vector<uint8_t>> &frames = set.frames;
-    const cyl_colortable &table = set.table;
+    const cyl_colortable &table = use3d ? set.table3d : set.table;
     const cyl_segment_params &params = set.params;
     cyl_segmentation &seg = set.seg;
 
@@ -66,7 +68,7 @@ int main(int argc, char **argv)
     cv::Mat bgr, mask, labels, stats, centroids;
     const cv::Scalar lo[2] = {cv::Scalar(0, 90, 200), cv::Scalar(60, 150, 0)};
     const cv::Scalar hi[2] = {cv::Scalar(120, 190, 255), cv::Scalar(170, 255, 120)};
-    std::vector<double> t_cyl, t_mem, t_cv;
+    std::vector<double> t_cyl, t_mem, t_cv, t_3d;
     unsigned long sink = 0, cv_blobs = 0, cyl_blobs = 0;
     for (int i = 0; i < iterations; i++) {
         const std::vector<uint8_t> &f = frames[i % nframes];
@@ -80,8 +82,12 @@ int main(int argc, char **argv)
         cyl_segment(&table, &img, &params, &seg);
         double t3 = now_us();
         cyl_blobs += seg.n_blobs;
+        double t6 = now_us();
+        cyl_segment(&set.table3d, &img, &params, &seg);
+        double t7 = now_us();
         t_mem.push_back(t1 - t0);
         t_cyl.push_back(t3 - t2);
+        t_3d.push_back(t7 - t6);
         if (i % 3 == 0) {  // OpenCV is slow: a third of the iterations still gives hundreds of samples
             cv::Mat yuyv((int)kH, (int)kW, CV_8UC2, const_cast<uint8_t *>(f.data()));
             double t4 = now_us();
@@ -94,16 +100,18 @@ int main(int argc, char **argv)
             t_cv.push_back(t5 - t4);
         }
     }
-    double m_cyl = median(t_cyl), m_mem = median(t_mem), m_cv = median(t_cv);
+    double m_cyl = median(t_cyl), m_mem = median(t_mem), m_cv = median(t_cv), m_3d = median(t_3d);
     std::printf("640x480 YUYV, %d distinct frames, %d iterations (OpenCV %zu), one thread\n", nframes,
                 iterations, t_cv.size());
     std::printf("%-52s %12s %10s\n", "pipeline", "median us", "ratio");
     std::printf("%-52s %12.1f %10s\n", "memcpy of the frame (floor)", m_mem, "1.00x");
     std::printf("%-52s %12.1f %9.2fx\n", "libcyl classify+RLE+blobs (cyl_segment)", m_cyl, m_cyl / m_mem);
+    std::printf("%-52s %12.1f %9.2fx\n", "libcyl, same classes as a learned 3-D table", m_3d, m_3d / m_mem);
     std::printf("%-52s %12.1f %9.2fx\n", "OpenCV cvtColor+2 inRange+2 connectedComponents", m_cv, m_cv / m_mem);
     std::printf("libcyl blobs/frame %.2f; libcyl is %.1fx faster than OpenCV (sink %lu)\n",
                 (double)cyl_blobs / iterations, m_cv / m_cyl, sink % 7);
     std::printf("{\"libcyl_us\": %.2f, \"memcpy_us\": %.2f, \"opencv_us\": %.2f, \"libcyl_over_memcpy\": %.3f, "
-                "\"opencv_over_libcyl\": %.2f}\n", m_cyl, m_mem, m_cv, m_cyl / m_mem, m_cv / m_cyl);
+                "\"opencv_over_libcyl\": %.2f, \"libcyl_3d_us\": %.2f, \"table3d_over_box\": %.3f}\n", m_cyl, m_mem, m_cv,
+                m_cyl / m_mem, m_cv / m_cyl, m_3d, m_3d / m_cyl);
     return 0;
 }

@@ -127,7 +127,7 @@ int main(int argc, char **argv)
             cyl_colortable t;
             std::string log;
             synth::train_colortable(scene, &t, seed, &log);
-            std::vector<uint8_t> buf(CYL_TABLE_FILE_SIZE);
+            std::vector<uint8_t> buf(CYL_TABLE_FILE_MAX_SIZE);
             size_t n = 0;
             check(cyl_colortable_save(&t, buf.data(), buf.size(), &n), "cyl_colortable_save");
             cylfe::write_file_atomic(write_table, std::string(buf.begin(), buf.begin() + (std::ptrdiff_t)n));

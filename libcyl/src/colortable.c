@@ -8,6 +8,8 @@ void cyl_colortable_init(cyl_colortable *t)
     unsigned i;
     if (!t) return;
     memset(t, 0, sizeof *t);
+    memset(t->yuv, 0xFF, sizeof t->yuv);
+    t->lookup = CYL_LOOKUP_UV_Y;
     for (i = 0; i < CYL_MAX_CLASSES; i++) t->rgb[i][0] = t->rgb[i][1] = t->rgb[i][2] = 128;
 }
 
@@ -44,7 +46,61 @@ cyl_status cyl_colortable_clear_class(cyl_colortable *t, unsigned cls)
         t->y[i] &= keep;
         for (j = 0; j < 256; j++) t->uv[i][j] &= keep;
     }
+    {
+        cyl_mask *c = &t->yuv[0][0][0];
+        for (i = 0; i < CYL_YUV_CELLS; i++) c[i] |= (cyl_mask)(1u << cls);
+    }
+    t->lookup |= CYL_LOOKUP_UV_Y;   /* the class is now held off by uv and y alone */
+    t->live &= keep;
     return CYL_OK;
+}
+
+void cyl_colortable_refresh(cyl_colortable *t)
+{
+    unsigned b, need_uvy = 0, need_yuv;
+    cyl_mask live = 0;
+    if (!t) return;
+    need_yuv = (unsigned)cyl_colortable_has_yuv(t);
+    for (b = 0; b < CYL_MAX_CLASSES; b++) {
+        const cyl_mask bit = (cyl_mask)(1u << b);
+        uint8_t ymiss[CYL_YUV_NY], uvmiss[CYL_YUV_NC][CYL_YUV_NC];
+        unsigned i, j, yc, uc, vc, any_y = 0, any_uv = 0, any_yuv = 0, redundant = 1;
+        memset(ymiss, 0, sizeof ymiss);
+        memset(uvmiss, 0, sizeof uvmiss);
+        for (i = 0; i < 256; i++) {
+            if (!(t->y[i] & bit)) ymiss[i >> CYL_YUV_YSHIFT] = 1;
+            else any_y = 1;
+        }
+        for (i = 0; i < 256; i++)
+            for (j = 0; j < 256; j++) {
+                if (!(t->uv[i][j] & bit)) uvmiss[i >> CYL_YUV_CSHIFT][j >> CYL_YUV_CSHIFT] = 1;
+                else any_uv = 1;
+            }
+        /* does uv & y reject, for this class, some pixel whose 3-D cell accepts it? */
+        for (yc = 0; yc < CYL_YUV_NY; yc++)
+            for (uc = 0; uc < CYL_YUV_NC; uc++)
+                for (vc = 0; vc < CYL_YUV_NC; vc++)
+                    if (t->yuv[yc][uc][vc] & bit) {
+                        any_yuv = 1;
+                        if (ymiss[yc] || uvmiss[uc][vc]) redundant = 0;
+                    }
+        if (!(any_y && any_uv && any_yuv)) continue;   /* matches no pixel at all */
+        live |= bit;
+        if (!redundant) need_uvy = 1;
+    }
+    t->live = live;
+    t->lookup = (uint8_t)((need_uvy || !need_yuv ? CYL_LOOKUP_UV_Y : 0u) | (need_yuv ? CYL_LOOKUP_YUV : 0u));
+}
+
+int cyl_colortable_has_yuv(const cyl_colortable *t)
+{
+    const cyl_mask *c;
+    unsigned i;
+    if (!t) return 0;
+    c = &t->yuv[0][0][0];
+    for (i = 0; i < CYL_YUV_CELLS; i++)
+        if (c[i] != 0xFFu) return 1;
+    return 0;
 }
 
 cyl_status cyl_colortable_add_box(cyl_colortable *t, unsigned cls,
@@ -61,6 +117,8 @@ cyl_status cyl_colortable_add_box(cyl_colortable *t, unsigned cls,
     for (u = u_lo; u <= u_hi; u++)
         for (v = v_lo; v <= v_hi; v++) t->uv[u][v] |= bit;
     for (y = y_lo; y <= y_hi; y++) t->y[y] |= bit;
+    t->lookup |= CYL_LOOKUP_UV_Y;   /* a box class is limited by uv and y */
+    t->live |= bit;
     return CYL_OK;
 }
 
@@ -223,14 +281,18 @@ uint32_t cyl_crc32(uint32_t crc, const uint8_t *buf, size_t len)
 #define OFF_Y (OFF_CLASSES + CYL_MAX_CLASSES * CLASS_REC)
 #define OFF_UV (OFF_Y + 256u)
 #define OFF_CRC (OFF_UV + 65536u)
+#define OFF_YUV OFF_CRC
+#define OFF_CRC_V2 (OFF_YUV + CYL_YUV_CELLS)
 
 cyl_status cyl_colortable_save(const cyl_colortable *t, uint8_t *buf, size_t cap, size_t *len)
 {
     unsigned i;
+    int v2;
     if (!t || !buf) return CYL_ERR_ARG;
-    if (cap < CYL_TABLE_FILE_SIZE) return CYL_ERR_NOMEM;
+    v2 = cyl_colortable_has_yuv(t);
+    if (cap < (v2 ? CYL_TABLE_FILE_SIZE_V2 : CYL_TABLE_FILE_SIZE)) return CYL_ERR_NOMEM;
     memcpy(buf, "CYLT", 4);
-    cyl_put_u16(buf + 4, (uint16_t)CYL_TABLE_FILE_VERSION);
+    cyl_put_u16(buf + 4, (uint16_t)(v2 ? CYL_TABLE_FILE_VERSION_V2 : CYL_TABLE_FILE_VERSION));
     buf[6] = CYL_MAX_CLASSES;
     buf[7] = 0;
     for (i = 0; i < CYL_MAX_CLASSES; i++) {
@@ -242,22 +304,37 @@ cyl_status cyl_colortable_save(const cyl_colortable *t, uint8_t *buf, size_t cap
     }
     memcpy(buf + OFF_Y, t->y, 256);
     memcpy(buf + OFF_UV, t->uv, 65536);
-    cyl_put_u32(buf + OFF_CRC, cyl_crc32(0, buf, OFF_CRC));
-    if (len) *len = CYL_TABLE_FILE_SIZE;
+    if (v2) {
+        memcpy(buf + OFF_YUV, t->yuv, CYL_YUV_CELLS);
+        cyl_put_u32(buf + OFF_CRC_V2, cyl_crc32(0, buf, OFF_CRC_V2));
+    } else {
+        cyl_put_u32(buf + OFF_CRC, cyl_crc32(0, buf, OFF_CRC));
+    }
+    if (len) *len = v2 ? CYL_TABLE_FILE_SIZE_V2 : CYL_TABLE_FILE_SIZE;
     return CYL_OK;
 }
 
 cyl_status cyl_colortable_load(cyl_colortable *t, const uint8_t *buf, size_t len)
 {
-    unsigned i, k;
+    unsigned i, k, version;
+    size_t size, crc_off;
     if (!t || (!buf && len)) return CYL_ERR_ARG;
     if (len < 4) return CYL_ERR_FILE_TRUNCATED;
     if (memcmp(buf, "CYLT", 4) != 0) return CYL_ERR_FILE_MAGIC;
     if (len < 8) return CYL_ERR_FILE_TRUNCATED;
-    if (cyl_get_u16(buf + 4) != CYL_TABLE_FILE_VERSION) return CYL_ERR_FILE_VERSION;
-    if (len < CYL_TABLE_FILE_SIZE) return CYL_ERR_FILE_TRUNCATED;
-    if (cyl_crc32(0, buf, OFF_CRC) != cyl_get_u32(buf + OFF_CRC)) return CYL_ERR_FILE_CHECKSUM;
-    if (len > CYL_TABLE_FILE_SIZE) return CYL_ERR_FILE_CORRUPT;
+    version = cyl_get_u16(buf + 4);
+    if (version == CYL_TABLE_FILE_VERSION) {
+        size = CYL_TABLE_FILE_SIZE;
+        crc_off = OFF_CRC;
+    } else if (version == CYL_TABLE_FILE_VERSION_V2) {
+        size = CYL_TABLE_FILE_SIZE_V2;
+        crc_off = OFF_CRC_V2;
+    } else {
+        return CYL_ERR_FILE_VERSION;
+    }
+    if (len < size) return CYL_ERR_FILE_TRUNCATED;
+    if (cyl_crc32(0, buf, crc_off) != cyl_get_u32(buf + crc_off)) return CYL_ERR_FILE_CHECKSUM;
+    if (len > size) return CYL_ERR_FILE_CORRUPT;
     if (buf[6] != CYL_MAX_CLASSES || buf[7] != 0) return CYL_ERR_FILE_CORRUPT;
     for (i = 0; i < CYL_MAX_CLASSES; i++) {
         const uint8_t *rec = buf + OFF_CLASSES + i * CLASS_REC;
@@ -275,5 +352,10 @@ cyl_status cyl_colortable_load(cyl_colortable *t, const uint8_t *buf, size_t len
     }
     memcpy(t->y, buf + OFF_Y, 256);
     memcpy(t->uv, buf + OFF_UV, 65536);
+    if (version == CYL_TABLE_FILE_VERSION_V2)
+        memcpy(t->yuv, buf + OFF_YUV, CYL_YUV_CELLS);
+    else
+        memset(t->yuv, 0xFF, CYL_YUV_CELLS);
+    cyl_colortable_refresh(t);
     return CYL_OK;
 }

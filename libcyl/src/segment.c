@@ -15,6 +15,9 @@
 #include "cyl/segment.h"
 #include "internal.h"
 #include "lowbit.h"
+
+/* cells from one brightness level of the 3-D table to the next */
+#define YUV_YSTRIDE (CYL_YUV_NC * CYL_YUV_NC)
 #include <math.h>
 #include <string.h>
 
@@ -148,19 +151,32 @@ static int emit(rle_ctx *c, uint32_t x, uint32_t y, uint32_t len, unsigned cls)
  * format so that ysz and cs are constants. */
 CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t y,
                                 const uint8_t *yp, const unsigned ysz, const uint8_t *up,
-                                const uint8_t *vp, const unsigned cs, uint32_t x0, uint32_t x1)
+                                const uint8_t *vp, const unsigned cs, uint32_t x0, uint32_t x1,
+                                const unsigned lookup)
 {
     const cyl_mask (*uv)[256] = t->uv;
     const cyl_mask *ytab = t->y;
+    const cyl_mask *yuv = &t->yuv[0][0][0];
+    const cyl_mask live = t->live;
     unsigned cur = CYL_CLASS_NONE;
     uint32_t x = x0, start = x0, x_img0 = 0, xs = 1;
+    /* Class of luma Y given the pair's chroma mask m and its 3-D column col. */
+    /* lookup (a constant in each inlined copy) leaves out the parts that never reject */
+#define PAIR_CLASS(Y)                                                                         \
+    cyl_lowbit[lookup == CYL_LOOKUP_UV_Y ? (unsigned)(m & ytab[(Y)])                          \
+               : lookup == CYL_LOOKUP_YUV ? (unsigned)(col[((unsigned)(Y) >> CYL_YUV_YSHIFT) * YUV_YSTRIDE] & live) \
+               : (unsigned)(m & ytab[(Y)] & col[((unsigned)(Y) >> CYL_YUV_YSHIFT) * YUV_YSTRIDE])]
+#define PAIR_COL(U, V) (yuv + ((unsigned)(U) >> CYL_YUV_CSHIFT) * CYL_YUV_NC + ((unsigned)(V) >> CYL_YUV_CSHIFT))
     if (x & 1u) {
-        cyl_mask m = uv[up[(x / 2u) * cs]][vp[(x / 2u) * cs]];
-        STEP(cyl_lowbit[m & ytab[yp[x * ysz]]], x);
+        const uint8_t U = up[(x / 2u) * cs], V = vp[(x / 2u) * cs];
+        cyl_mask m = uv[U][V];
+        const cyl_mask *col = PAIR_COL(U, V);
+        STEP(PAIR_CLASS(yp[x * ysz]), x);
         x++;
     }
     while (x + 1u < x1) {
         cyl_mask m;
+        const cyl_mask *col;
         if (cur == CYL_CLASS_NONE) {
             /* Background fast path: skip pairs whose chroma is in no class,
              * two pairs at a time, without reading luma. */
@@ -171,40 +187,54 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
             if (x + 1u < x1 && uv[pu[0]][pv[0]] == 0) { x += 2u; continue; }
             if (x + 1u >= x1) break;
             m = uv[pu[0]][pv[0]];
+            col = PAIR_COL(pu[0], pv[0]);
         } else {
-            m = uv[up[(x / 2u) * cs]][vp[(x / 2u) * cs]];
+            const uint8_t U = up[(x / 2u) * cs], V = vp[(x / 2u) * cs];
+            m = uv[U][V];
+            col = PAIR_COL(U, V);
         }
-        STEP(cyl_lowbit[m & ytab[yp[x * ysz]]], x);
-        STEP(cyl_lowbit[m & ytab[yp[(x + 1u) * ysz]]], x + 1u);
+        STEP(PAIR_CLASS(yp[x * ysz]), x);
+        STEP(PAIR_CLASS(yp[(x + 1u) * ysz]), x + 1u);
         x += 2u;
     }
     if (x < x1) {
-        cyl_mask m = uv[up[(x / 2u) * cs]][vp[(x / 2u) * cs]];
-        STEP(cyl_lowbit[m & ytab[yp[x * ysz]]], x);
+        const uint8_t U = up[(x / 2u) * cs], V = vp[(x / 2u) * cs];
+        cyl_mask m = uv[U][V];
+        const cyl_mask *col = PAIR_COL(U, V);
+        STEP(PAIR_CLASS(yp[x * ysz]), x);
     }
+#undef PAIR_CLASS
+#undef PAIR_COL
     if (cur != CYL_CLASS_NONE && !emit(ctx, start, y, x1 - start, cur)) return 0;
     return 1;
 }
 
-/* One copy per format, with constant layouts. */
+/* One copy per format and lookup, with constant layouts. */
+#define ENCODE_BY_LOOKUP(...)                                                         \
+    switch (t->lookup) {                                                              \
+    case CYL_LOOKUP_UV_Y: return encode_pairs(__VA_ARGS__, CYL_LOOKUP_UV_Y);         \
+    case CYL_LOOKUP_YUV: return encode_pairs(__VA_ARGS__, CYL_LOOKUP_YUV);           \
+    default: return encode_pairs(__VA_ARGS__, CYL_LOOKUP_UV_Y | CYL_LOOKUP_YUV);     \
+    }
 static int encode_yuyv(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r, uint32_t x0, uint32_t x1)
 {
-    return encode_pairs(c, t, y, r, 2u, r + 1, r + 3, 4u, x0, x1);
+    ENCODE_BY_LOOKUP(c, t, y, r, 2u, r + 1, r + 3, 4u, x0, x1)
 }
 static int encode_uyvy(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r, uint32_t x0, uint32_t x1)
 {
-    return encode_pairs(c, t, y, r + 1, 2u, r, r + 2, 4u, x0, x1);
+    ENCODE_BY_LOOKUP(c, t, y, r + 1, 2u, r, r + 2, 4u, x0, x1)
 }
 static int encode_nv12(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r,
                        const uint8_t *uv, uint32_t x0, uint32_t x1)
 {
-    return encode_pairs(c, t, y, r, 1u, uv, uv + 1, 2u, x0, x1);
+    ENCODE_BY_LOOKUP(c, t, y, r, 1u, uv, uv + 1, 2u, x0, x1)
 }
 static int encode_i420(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r,
                        const uint8_t *u, const uint8_t *v, uint32_t x0, uint32_t x1)
 {
-    return encode_pairs(c, t, y, r, 1u, u, v, 1u, x0, x1);
+    ENCODE_BY_LOOKUP(c, t, y, r, 1u, u, v, 1u, x0, x1)
 }
+#undef ENCODE_BY_LOOKUP
 
 /* Any format and step: one pixel fetch per sample. */
 static int encode_generic(rle_ctx *ctx, const cyl_colortable *t, const cyl_image *img,
@@ -215,7 +245,7 @@ static int encode_generic(rle_ctx *ctx, const cyl_colortable *t, const cyl_image
     for (i = 0; i < n; i++) {
         uint8_t Y, U, V;
         cyl_pixel_fetch(img, x_img0 + i * xs, y, &Y, &U, &V);
-        STEP(cyl_lowbit[t->uv[U][V] & t->y[Y]], i);
+        STEP(cyl_lowbit[cyl_colortable_mask(t, Y, U, V)], i);
     }
     if (cur != CYL_CLASS_NONE && !emit(ctx, x_img0 + start * xs, y, n - start, cur)) return 0;
     return 1;

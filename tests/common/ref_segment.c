@@ -33,7 +33,8 @@ int ref_segment(const cyl_colortable *t, const cyl_image *img, const cyl_segment
             uint8_t Y, U, V;
             unsigned m, c = CYL_CLASS_NONE, k;
             cyl_image_pixel(img, rx + i * xs, ry + j * ys, &Y, &U, &V);
-            m = t->uv[U][V] & t->y[Y];
+            /* the table's rule written out: chroma, brightness and the 3-D cell */
+            m = t->uv[U][V] & t->y[Y] & t->yuv[Y / 8u][U / 4u][V / 4u];
             for (k = 0; k < 8; k++) if (m & (1u << k)) { c = k; break; }
             cls[j * nx + i] = c == CYL_CLASS_NONE ? -1 : (int)c;
         }

@@ -156,7 +156,7 @@ static void test_file_round_trip_and_corruption(void **state)
     assert_int_equal(cyl_colortable_load(b, buf, 1000), CYL_ERR_FILE_TRUNCATED);
     memcpy(bad, buf, len); bad[0] = 'X';
     assert_int_equal(cyl_colortable_load(b, bad, len), CYL_ERR_FILE_MAGIC);
-    memcpy(bad, buf, len); bad[4] = 2;
+    memcpy(bad, buf, len); bad[4] = 3;
     assert_int_equal(cyl_colortable_load(b, bad, len), CYL_ERR_FILE_VERSION);
     memcpy(bad, buf, len); bad[424 + 20 * 256 + 45] ^= 0x01;   /* one bit of the UV table */
     assert_int_equal(cyl_colortable_load(b, bad, len), CYL_ERR_FILE_CHECKSUM);
@@ -191,6 +191,56 @@ static void test_file_round_trip_and_corruption(void **state)
     free(a); free(b); free(buf); free(bad);
 }
 
+/* Version 2: a table with a 3-D part saves as version 2 and loads back identical; a table
+ * without one saves as version 1; a version-1 file loads with every 3-D cell all ones. */
+static void test_file_version_2(void **state)
+{
+    cyl_colortable *a = malloc(sizeof *a), *b = malloc(sizeof *b);
+    uint8_t *buf = malloc(CYL_TABLE_FILE_MAX_SIZE + 16), *bad = malloc(CYL_TABLE_FILE_MAX_SIZE + 16);
+    size_t len = 0, i;
+    int ones = 1;
+    (void)state;
+    assert_int_equal(CYL_TABLE_FILE_SIZE_V2, CYL_TABLE_FILE_SIZE + CYL_YUV_CELLS);
+    cyl_colortable_init(a);
+    assert_false(cyl_colortable_has_yuv(a));
+    cyl_colortable_set_class(a, 1, "ball", 255, 255, 0);
+    cyl_colortable_add_box(a, 1, 0, 255, 0, 255, 0, 255);
+    a->yuv[3][10][20] &= (cyl_mask)~2u;                   /* dark (Y 24..31), U 40..43, V 80..83: not ball */
+    assert_true(cyl_colortable_has_yuv(a));
+    assert_int_equal(a->lookup, CYL_LOOKUP_UV_Y);
+    cyl_colortable_refresh(a);   /* the box covers every colour: only the 3-D table rejects */
+    assert_int_equal(a->lookup, CYL_LOOKUP_YUV);
+    assert_int_equal(cyl_colortable_mask(a, 24, 40, 80), 0);
+    assert_int_equal(cyl_colortable_mask(a, 32, 40, 80), 2);    /* the next brightness cell */
+    assert_int_equal(cyl_colortable_mask(a, 31, 44, 83), 2);    /* the next U cell */
+    assert_int_equal(cyl_colortable_save(a, buf, CYL_TABLE_FILE_SIZE_V2 - 1, &len), CYL_ERR_NOMEM);
+    assert_int_equal(cyl_colortable_save(a, buf, CYL_TABLE_FILE_MAX_SIZE, &len), CYL_OK);
+    assert_int_equal(len, CYL_TABLE_FILE_SIZE_V2);
+    assert_memory_equal(buf, "CYLT\x02\x00\x08\x00", 8);
+    assert_int_equal(buf[CYL_TABLE_FILE_SIZE - 4 + (3 * 64 + 10) * 64 + 20], 0xFD);
+    memset(b, 0x33, sizeof *b);
+    assert_int_equal(cyl_colortable_load(b, buf, len), CYL_OK);
+    assert_memory_equal(a, b, sizeof *a);
+    assert_int_equal(cyl_colortable_load(b, buf, len - 1), CYL_ERR_FILE_TRUNCATED);
+    assert_int_equal(cyl_colortable_load(b, buf, CYL_TABLE_FILE_SIZE), CYL_ERR_FILE_TRUNCATED);
+    memcpy(bad, buf, len); bad[CYL_TABLE_FILE_SIZE + 100] ^= 1;   /* one 3-D cell */
+    assert_int_equal(cyl_colortable_load(b, bad, len), CYL_ERR_FILE_CHECKSUM);
+    /* clearing the class restores all-ones cells: the table saves as version 1 again */
+    cyl_colortable_clear_class(a, 1);
+    assert_false(cyl_colortable_has_yuv(a));
+    assert_true(a->lookup & CYL_LOOKUP_UV_Y);
+    assert_int_equal(cyl_colortable_mask(a, 24, 40, 80), 0);
+    assert_int_equal(cyl_colortable_save(a, buf, CYL_TABLE_FILE_MAX_SIZE, &len), CYL_OK);
+    assert_int_equal(len, CYL_TABLE_FILE_SIZE);
+    assert_int_equal(buf[4], 1);
+    /* a version-1 file over a table that had a 3-D part: all ones after the load */
+    memset(b->yuv, 0, sizeof b->yuv);
+    assert_int_equal(cyl_colortable_load(b, buf, len), CYL_OK);
+    for (i = 0; i < CYL_YUV_CELLS; i++) ones &= (&b->yuv[0][0][0])[i] == 0xFF;
+    assert_true(ones);
+    free(a); free(b); free(buf); free(bad);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -198,6 +248,7 @@ int main(void)
         cmocka_unit_test(test_mask_rule_and_priority),
         cmocka_unit_test(test_classify_image),
         cmocka_unit_test(test_train_region),
+        cmocka_unit_test(test_file_version_2),
         cmocka_unit_test(test_file_round_trip_and_corruption),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

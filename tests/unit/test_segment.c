@@ -420,6 +420,18 @@ static void test_bruteforce_random(void **state)
     /* a third, overlapping class to exercise the priority rule */
     cyl_colortable_set_class(&table, 2, "pink", 255, 100, 200);
     cyl_colortable_add_box(&table, 2, 100, 255, 75, 130, 150, 200);
+    /* and a brightness-dependent (3-D) part: pink only in every other brightness cell and
+     * not at a few chroma cells, so that the lookup's yuv path decides pixels too */
+    {
+        unsigned yc, uc, vc;
+        for (yc = 0; yc < CYL_YUV_NY; yc++)
+            for (uc = 0; uc < CYL_YUV_NC; uc++)
+                for (vc = 0; vc < CYL_YUV_NC; vc++)
+                    if ((yc & 1u) || ((uc + vc) % 3u) == 0) table.yuv[yc][uc][vc] &= (cyl_mask)~(1u << 2);
+        assert_int_equal(table.lookup, CYL_LOOKUP_UV_Y);   /* stale: the edit was by hand */
+        cyl_colortable_refresh(&table);
+        assert_int_equal(table.lookup, CYL_LOOKUP_UV_Y | CYL_LOOKUP_YUV);
+    }
     assert_int_equal(cyl_segmentation_init(&seg, mem, ms, max_runs, max_blobs), CYL_OK);
     test_rng_seed(&rng, 20261122);
     for (iter = 0; iter < 3000; iter++) {

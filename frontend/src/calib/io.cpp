@@ -113,7 +113,7 @@ void load_table(const std::string &path, cyl_colortable &t)
 
 void save_table(const std::string &path, const cyl_colortable &t)
 {
-    std::string b(CYL_TABLE_FILE_SIZE, '\0');
+    std::string b(CYL_TABLE_FILE_MAX_SIZE, '\0');
     size_t n = 0;
     check(cyl_colortable_save(&t, reinterpret_cast<uint8_t *>(&b[0]), b.size(), &n), path + ": serialising the table");
     b.resize(n);

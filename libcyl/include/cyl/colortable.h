@@ -3,16 +3,25 @@
  *
  * A pixel (Y, U, V) belongs to the set of classes whose bits are set in
  *
- *     mask = uv[U][V] & y[Y]
+ *     mask = uv[U][V] & y[Y] & yuv[Y >> 3][U >> 2][V >> 2]
  *
  * uv is a 256x256 table of class bitmasks over chrominance; y is a 256-entry
  * vector of class bitmasks over brightness, so that each class has its own
  * brightness window (the paper's single window is the case where every class
- * has the same one). Class i is bit (1 << i). When a pixel matches several
- * classes, the lowest index wins (class 0 has the highest priority).
+ * has the same one). yuv is a quantised 3-D table (32 brightness x 64 x 64
+ * chroma cells) in which a class's chroma may depend on brightness, as real
+ * colours do under changing illumination; the learned classes of
+ * cyl/colorlearn.h live there. A class made of boxes (the paper's method,
+ * cyl_colortable_add_box) keeps its bit set in every yuv cell; a learned class
+ * keeps its bit set in every y entry and its uv bits are the yuv cells'
+ * projection, so the uv table alone still says which chroma can be coloured
+ * (the segmentation's background skip reads only uv).
+ * Class i is bit (1 << i). When a pixel matches several classes, the lowest
+ * index wins (class 0 has the highest priority); learning resolves overlaps
+ * between learned classes by likelihood before they reach the table.
  *
- * The table is a plain struct of about 66 KiB owned by the caller (static,
- * stack or heap); nothing here allocates.
+ * The table is a plain struct of about 193 KiB owned by the caller (static,
+ * stack, heap or const in flash); nothing here allocates.
  */
 #ifndef CYL_COLORTABLE_H
 #define CYL_COLORTABLE_H
@@ -32,14 +41,34 @@ extern "C" {
 
 typedef uint8_t cyl_mask;      /* bit i set = class i */
 
+/* The 3-D table's quantisation: Y >> CYL_YUV_YSHIFT, U and V >> CYL_YUV_CSHIFT. */
+#define CYL_YUV_YSHIFT 3u
+#define CYL_YUV_CSHIFT 2u
+#define CYL_YUV_NY (256u >> CYL_YUV_YSHIFT)   /* 32 brightness cells, 8 levels each */
+#define CYL_YUV_NC (256u >> CYL_YUV_CSHIFT)   /* 64 cells per chroma axis, 4 levels each */
+#define CYL_YUV_CELLS (CYL_YUV_NY * CYL_YUV_NC * CYL_YUV_NC)  /* 131072 */
+
 typedef struct cyl_colortable {
     cyl_mask uv[256][256];                            /* class bits by chrominance, indexed [U][V] */
     cyl_mask y[256];                                  /* class bits by brightness, indexed [Y] */
+    cyl_mask yuv[CYL_YUV_NY][CYL_YUV_NC][CYL_YUV_NC]; /* class bits by quantised colour, indexed
+                                                         [Y >> 3][U >> 2][V >> 2] (all ones for box classes) */
+    uint8_t lookup;                                   /* CYL_LOOKUP_* bits: which parts of the rule can
+                                                         reject a pixel (segmentation skips the others);
+                                                         kept by every function here; after writing uv, y
+                                                         or yuv directly, call cyl_colortable_refresh() */
+    cyl_mask live;                                    /* classes that can match some pixel; read only when
+                                                         lookup is CYL_LOOKUP_YUV alone (set by
+                                                         cyl_colortable_refresh()) */
     char name[CYL_MAX_CLASSES][CYL_CLASS_NAME_LEN];   /* NUL-terminated class names ("" = unused) */
     uint8_t rgb[CYL_MAX_CLASSES][3];                  /* display colour of each class (overlays), 0..255 */
 } cyl_colortable;
 
-/* Empty table: no class matches any pixel, names empty, display colours grey. */
+#define CYL_LOOKUP_UV_Y 1u   /* uv[U][V] & y[Y] can reject a pixel the 3-D table accepts */
+#define CYL_LOOKUP_YUV 2u    /* the 3-D table can reject a pixel */
+
+/* Empty table: no class matches any pixel (uv and y zero, yuv all ones), names
+ * empty, display colours grey. */
 void cyl_colortable_init(cyl_colortable *t);
 
 /* Set a class's name (truncated to CYL_CLASS_NAME_LEN-1 bytes) and display colour. */
@@ -49,7 +78,9 @@ cyl_status cyl_colortable_set_class(cyl_colortable *t, unsigned cls, const char 
 /* Index of the class with this exact name, or -1. */
 int cyl_colortable_find_class(const cyl_colortable *t, const char *name);
 
-/* Remove every bit of class cls from uv and y (its name and colour stay). */
+/* Remove class cls's colours: its bits in uv and y are cleared and its yuv bits
+ * set again, so that it matches nothing and boxes can be added afresh (its name
+ * and colour stay). */
 cyl_status cyl_colortable_clear_class(cyl_colortable *t, unsigned cls);
 
 /* Add an axis-aligned box to class cls: U in [u_lo, u_hi], V in [v_lo, v_hi],
@@ -63,8 +94,17 @@ cyl_status cyl_colortable_add_box(cyl_colortable *t, unsigned cls,
 /* Class mask of one YUV value. */
 static inline cyl_mask cyl_colortable_mask(const cyl_colortable *t, uint8_t Y, uint8_t U, uint8_t V)
 {
-    return (cyl_mask)(t->uv[U][V] & t->y[Y]);
+    return (cyl_mask)(t->uv[U][V] & t->y[Y] &
+                      t->yuv[Y >> CYL_YUV_YSHIFT][U >> CYL_YUV_CSHIFT][V >> CYL_YUV_CSHIFT]);
 }
+
+/* 1 if any class has a brightness-dependent (3-D) part, i.e. some yuv cell is not all ones. */
+int cyl_colortable_has_yuv(const cyl_colortable *t);
+
+/* Recompute t->lookup from the table's contents (after editing uv, y or yuv by hand).
+ * A lookup field with extra bits set is still correct, only slower; one with a bit
+ * missing makes segmentation disagree with cyl_colortable_mask(). */
+void cyl_colortable_refresh(cyl_colortable *t);
 
 /* Index of the lowest set bit of a mask, or CYL_CLASS_NONE for 0. */
 unsigned cyl_mask_class(cyl_mask m);
@@ -107,7 +147,7 @@ cyl_status cyl_colortable_train(cyl_colortable *t, unsigned cls, const cyl_image
                                 void *work, size_t work_size, uint8_t box[6]);
 
 /* ---- table files ---------------------------------------------------------
- * Format "CYLT" version 1, little-endian, fixed size CYL_TABLE_FILE_SIZE bytes:
+ * Format "CYLT", little-endian. Version 1, fixed size CYL_TABLE_FILE_SIZE bytes:
  *   offset     size   field
  *   0          4      magic "CYLT"
  *   4          2      format version (1)
@@ -121,10 +161,21 @@ cyl_status cyl_colortable_train(cyl_colortable *t, unsigned cls, const cyl_image
 #define CYL_TABLE_FILE_VERSION 1u
 #define CYL_TABLE_FILE_SIZE 65964u
 
-/* Serialise into buf (cap >= CYL_TABLE_FILE_SIZE); *len receives the byte count. */
+/* Version 2 (CYL_TABLE_FILE_SIZE_V2 bytes) is version 1 with the 3-D table
+ * inserted before the CRC:
+ *   65960      131072 yuv[32][64][64] class masks, Y-major, then U, then V
+ *   197032     4      CRC-32 of bytes 0..197031
+ * A version-1 file loads as a table whose yuv cells are all ones. */
+#define CYL_TABLE_FILE_VERSION_V2 2u
+#define CYL_TABLE_FILE_SIZE_V2 197036u
+#define CYL_TABLE_FILE_MAX_SIZE CYL_TABLE_FILE_SIZE_V2   /* the largest file any version has */
+
+/* Serialise into buf: version 1 when no class has a 3-D part (so older readers
+ * still load it), version 2 otherwise. cap must be at least the size written
+ * (CYL_TABLE_FILE_MAX_SIZE always suffices); *len receives the byte count. */
 cyl_status cyl_colortable_save(const cyl_colortable *t, uint8_t *buf, size_t cap, size_t *len);
 
-/* Parse a serialised table. On any error *t is left untouched. Errors:
+/* Parse a serialised table, version 1 or 2. On any error *t is left untouched. Errors:
  * CYL_ERR_FILE_TRUNCATED, _MAGIC, _VERSION, _CHECKSUM, _CORRUPT. */
 cyl_status cyl_colortable_load(cyl_colortable *t, const uint8_t *buf, size_t len);
 

@@ -1,0 +1,117 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* libcyl -- learning colour classes from labelled examples.
+ *
+ * The paper trains a class as a rectangle in chrominance plus a brightness
+ * window (cyl_colortable_train). On real camera images that rectangle spans
+ * whatever grey, edge or background pixels a training region holds. Here a
+ * class is learned as a likelihood ratio instead:
+ *
+ *  1. Count the training pixels of each class ("positives", e.g. the pixels
+ *     inside its labelled boxes) and of the background ("negatives", by
+ *     default every pixel outside all labelled boxes) in histograms over the
+ *     3-D table's quantised YUV cells (cyl_colorhist, 32 x 64 x 64 cells), in
+ *     which chroma may depend on brightness.
+ *  2. Smooth both with a Gaussian of smooth_sigma_cells cells per axis, so
+ *     that colours next to the seen ones (slightly brighter, slightly more
+ *     saturated) are covered too, and mix into the background density a
+ *     uniform part of weight bg_uniform_weight: a colour never seen in
+ *     training is not known to be free of background.
+ *  3. A cell's likelihood ratio is L = p_class / p_background. The class
+ *     claims every cell with L above the lowest threshold for which the
+ *     background pixels it would claim stay within max_bg_fraction (the
+ *     false-positive rate, Neyman-Pearson) and never a cell with L below
+ *     min_likelihood_ratio.
+ *  4. Where two learned classes claim a cell, the one with the larger L keeps
+ *     it; the report says how much each class lost to each other.
+ *
+ * The result is written into the table's yuv cells, so segmentation stays a
+ * direct lookup. Nothing here allocates: histograms and the workspace are the
+ * caller's (cyl_learn_workspace_size()).
+ */
+#ifndef CYL_COLORLEARN_H
+#define CYL_COLORLEARN_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "cyl/status.h"
+#include "cyl/image.h"
+#include "cyl/colortable.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Pixel counts per cell of the 3-D table, indexed like cyl_colortable.yuv
+ * flattened: ((Y >> 3) * 64 + (U >> 2)) * 64 + (V >> 2). 512 KiB. */
+typedef struct cyl_colorhist {
+    uint32_t count[CYL_YUV_CELLS];   /* training pixels per cell */
+    uint64_t total;                  /* training pixels added (sum of count) */
+} cyl_colorhist;
+
+/* Cell index of a colour. */
+static inline uint32_t cyl_yuv_cell(uint8_t Y, uint8_t U, uint8_t V)
+{
+    return (((uint32_t)(Y >> CYL_YUV_YSHIFT) * CYL_YUV_NC) + (uint32_t)(U >> CYL_YUV_CSHIFT)) * CYL_YUV_NC +
+           (uint32_t)(V >> CYL_YUV_CSHIFT);
+}
+
+/* Empty histogram. */
+void cyl_colorhist_clear(cyl_colorhist *h);
+
+/* Add the pixels of img inside roi (NULL = whole image) to h. With a mask
+ * (one byte per image pixel, mask[y * mask_stride + x] in full-image
+ * coordinates, mask_stride >= width) only pixels whose byte equals
+ * mask_value count; mask NULL counts every pixel. A count that would pass
+ * 2^32 - 1 saturates. */
+cyl_status cyl_colorhist_add(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
+                             const uint8_t *mask, size_t mask_stride, uint8_t mask_value);
+
+typedef struct cyl_learn_params {
+    double max_bg_fraction;      /* false-positive rate: the share of the background density a class
+                                    may claim, 0..1 (default 0.001) */
+    double smooth_sigma_cells;   /* Gaussian smoothing of both histograms, sigma in cells per axis
+                                    (a cell is 8 Y and 4 U/V levels), 0 = none (default 1.0) */
+    double bg_uniform_weight;    /* weight of the uniform colour density mixed into the background
+                                    model, 0..1 (default 0.02) */
+    double min_likelihood_ratio; /* a cell with a smaller ratio is never claimed (default 4) */
+    double min_positive_count;   /* ... nor one whose smoothed count of class pixels is below this,
+                                    pixels (default 0.5: stray single pixels claim nothing) */
+} cyl_learn_params;
+
+/* The defaults above. */
+cyl_learn_params cyl_learn_params_default(void);
+
+/* What learning did for one class. Shares are of training pixels (raw counts,
+ * not smoothed). */
+typedef struct cyl_learn_report {
+    double recall;                /* share of the class's positive pixels in the cells it kept */
+    double recall_alone;          /* ... in the cells it claimed before overlaps were resolved */
+    double bg_fraction;           /* share of the negative pixels in the cells it kept */
+    double lr_threshold;          /* likelihood-ratio threshold the false-positive rate chose */
+    uint32_t cells;               /* cells kept */
+    double grey_fraction;         /* share of its kept cells whose chroma lies within 8 levels of grey
+                                     (U and V both within 128 +- 8) */
+    double lost_to[CYL_MAX_CLASSES]; /* share of its positive pixels in cells claimed by both it and
+                                        class j that class j kept (larger likelihood ratio) */
+} cyl_learn_report;
+
+/* Bytes of workspace cyl_colortable_learn() needs for n classes. */
+size_t cyl_learn_workspace_size(unsigned n);
+
+/* Learn n classes at once: class cls[i] of t from the histogram positive[i],
+ * against the background histogram negative (shared by all). Each learned
+ * class's previous colours are replaced (cyl_colortable_clear_class) by its
+ * learned cells; other classes are untouched. reports (n entries) may be NULL.
+ * work: cyl_learn_workspace_size(n) bytes aligned for float.
+ * Errors: CYL_ERR_ARG (bad parameter, repeated class), CYL_ERR_CLASS,
+ * CYL_ERR_NOMEM (workspace), CYL_ERR_EMPTY (a class or the background has no
+ * pixels, or a class would claim no cell; the table is then unchanged). */
+cyl_status cyl_colortable_learn(cyl_colortable *t, const unsigned *cls,
+                                const cyl_colorhist *const *positive, unsigned n,
+                                const cyl_colorhist *negative, const cyl_learn_params *params,
+                                void *work, size_t work_size, cyl_learn_report *reports);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* CYL_COLORLEARN_H */

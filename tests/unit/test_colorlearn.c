@@ -1,0 +1,245 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* Colour learning: histograms, the likelihood-ratio decision at a false-positive rate
+ * (hand-derived cases), overlap resolution, brightness-dependent chroma, and errors. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cyl/colorlearn.h"
+#include "synth_frames.h"
+
+static cyl_colorhist *hist_new(void)
+{
+    cyl_colorhist *h = malloc(sizeof *h);
+    cyl_colorhist_clear(h);
+    return h;
+}
+
+static void put(cyl_colorhist *h, uint8_t Y, uint8_t U, uint8_t V, uint32_t n)
+{
+    h->count[cyl_yuv_cell(Y, U, V)] += n;
+    h->total += n;
+}
+
+static cyl_learn_params exact_params(void)
+{
+    cyl_learn_params p = cyl_learn_params_default();
+    p.smooth_sigma_cells = 0.0;   /* the counts as they are */
+    p.bg_uniform_weight = 0.0;
+    p.min_likelihood_ratio = 1.0;
+    p.min_positive_count = 0.0;
+    return p;
+}
+
+static void test_hist_add(void **state)
+{
+    canvas c;
+    cyl_image img;
+    uint8_t *buf, mask[8 * 6];
+    size_t cap;
+    cyl_roi roi = { 2, 1, 3, 2 };
+    cyl_colorhist *h = hist_new();
+    (void)state;
+    assert_true(canvas_alloc(&c, 8, 6));
+    canvas_fill(&c, 100, 60, 200);
+    canvas_rect(&c, 0, 0, 4, 6, 20, 130, 131);    /* left half dark grey */
+    cap = canvas_format_size(&c, CYL_FMT_YUV444P, 0);
+    buf = malloc(cap);
+    assert_true(canvas_to_format(&c, CYL_FMT_YUV444P, 0, 0, buf, cap, &img));
+    assert_int_equal(cyl_colorhist_add(h, &img, NULL, NULL, 0, 0), CYL_OK);
+    assert_int_equal(h->total, 48);
+    assert_int_equal(h->count[cyl_yuv_cell(100, 60, 200)], 24);
+    assert_int_equal(h->count[cyl_yuv_cell(20, 130, 131)], 24);
+    assert_int_equal(cyl_yuv_cell(20, 130, 131), (2u * 64u + 32u) * 64u + 32u);
+    /* ROI columns 2..4, rows 1..2: 2 dark + 1 coloured per row */
+    cyl_colorhist_clear(h);
+    assert_int_equal(cyl_colorhist_add(h, &img, &roi, NULL, 0, 0), CYL_OK);
+    assert_int_equal(h->total, 6);
+    assert_int_equal(h->count[cyl_yuv_cell(100, 60, 200)], 2);
+    /* mask: only bytes equal to 7 count, in full-image coordinates */
+    memset(mask, 0, sizeof mask);
+    mask[1 * 8 + 4] = 7; mask[2 * 8 + 2] = 7; mask[5 * 8 + 7] = 7;   /* the last is outside the ROI */
+    cyl_colorhist_clear(h);
+    assert_int_equal(cyl_colorhist_add(h, &img, &roi, mask, 8, 7), CYL_OK);
+    assert_int_equal(h->total, 2);
+    assert_int_equal(h->count[cyl_yuv_cell(100, 60, 200)], 1);
+    assert_int_equal(h->count[cyl_yuv_cell(20, 130, 131)], 1);
+    assert_int_equal(cyl_colorhist_add(h, &img, &roi, mask, 7, 7), CYL_ERR_SIZE);
+    roi.width = 9;
+    assert_int_equal(cyl_colorhist_add(h, &img, &roi, NULL, 0, 0), CYL_ERR_SIZE);
+    assert_int_equal(cyl_colorhist_add(NULL, &img, NULL, NULL, 0, 0), CYL_ERR_ARG);
+    canvas_free(&c);
+    free(buf); free(h);
+}
+
+/* Positives: 900 px at colour a, 100 at colour c. Negatives: 10 px at c, 9990 at b.
+ * Ratios: a infinite (no background), c = 0.1 / 0.001 = 100, b = 0. */
+static void test_rate_decides_hand_derived(void **state)
+{
+    cyl_colorhist *pos = hist_new(), *neg = hist_new();
+    cyl_colortable *t = malloc(sizeof *t);
+    const cyl_colorhist *pp[1];
+    unsigned cls = 2;
+    size_t ws = cyl_learn_workspace_size(1);
+    void *work = malloc(ws);
+    cyl_learn_params p = exact_params();
+    cyl_learn_report r;
+    (void)state;
+    put(pos, 120, 200, 60, 900);   /* a */
+    put(pos, 120, 90, 90, 100);    /* c */
+    put(neg, 120, 90, 90, 10);     /* c */
+    put(neg, 60, 128, 128, 9990);  /* b */
+    pp[0] = pos;
+    cyl_colortable_init(t);
+    cyl_colortable_set_class(t, 2, "x", 1, 2, 3);
+
+    p.max_bg_fraction = 0.0005;    /* c would claim 0.001 of the background: not allowed */
+    assert_int_equal(cyl_colortable_learn(t, &cls, pp, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(r.cells, 1);
+    assert_float_equal(r.recall, 0.9, 1e-12);
+    assert_float_equal(r.recall_alone, 0.9, 1e-12);
+    assert_float_equal(r.bg_fraction, 0.0, 1e-12);
+    assert_int_equal(cyl_colortable_mask(t, 120, 200, 60), 1u << 2);
+    assert_int_equal(cyl_colortable_mask(t, 127, 203, 63), 1u << 2);   /* same cell */
+    assert_int_equal(cyl_colortable_mask(t, 128, 200, 60), 0);          /* next brightness cell */
+    assert_int_equal(cyl_colortable_mask(t, 120, 90, 90), 0);
+    assert_int_equal(t->uv[200][60], 1u << 2);                          /* uv: the projection */
+    assert_int_equal(t->uv[90][90], 0);
+    assert_int_equal(t->y[0], 1u << 2);
+
+    p.max_bg_fraction = 0.002;     /* now c fits */
+    assert_int_equal(cyl_colortable_learn(t, &cls, pp, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(r.cells, 2);
+    assert_float_equal(r.recall, 1.0, 1e-12);
+    assert_float_equal(r.bg_fraction, 0.001, 1e-12);
+    assert_true(r.lr_threshold < 100.0);
+    assert_int_equal(cyl_colortable_mask(t, 120, 90, 90), 1u << 2);
+
+    p.min_likelihood_ratio = 150;  /* ... unless its ratio (100) is below the floor */
+    assert_int_equal(cyl_colortable_learn(t, &cls, pp, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(r.cells, 1);
+    assert_int_equal(cyl_colortable_mask(t, 120, 90, 90), 0);
+
+    /* the uniform background part: with weight w over K cells, a's ratio is
+     * 0.9 / (w / K); with w = 1 it is 0.9 * 131072 = 117965 > 100000 (kept), and
+     * a floor of 120000 drops it */
+    p = exact_params();
+    p.bg_uniform_weight = 1.0;
+    p.min_likelihood_ratio = 100000;
+    assert_int_equal(cyl_colortable_learn(t, &cls, pp, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(r.cells, 1);
+    p.min_likelihood_ratio = 120000;
+    assert_int_equal(cyl_colortable_learn(t, &cls, pp, 1, neg, &p, work, ws, &r), CYL_ERR_EMPTY);
+    free(pos); free(neg); free(t); free(work);
+}
+
+/* Two classes claim one cell: the one with the larger ratio keeps it, the report says so. */
+static void test_overlap_resolved_by_ratio(void **state)
+{
+    cyl_colorhist *a = hist_new(), *b = hist_new(), *neg = hist_new();
+    cyl_colortable *t = malloc(sizeof *t);
+    const cyl_colorhist *pp[2];
+    unsigned cls[2] = { 0, 5 };
+    size_t ws = cyl_learn_workspace_size(2);
+    void *work = malloc(ws);
+    cyl_learn_params p = exact_params();
+    cyl_learn_report r[2];
+    (void)state;
+    put(a, 150, 80, 180, 800);  put(a, 150, 100, 160, 200);   /* shared cell s = (150,100,160) */
+    put(b, 150, 60, 200, 500);  put(b, 150, 100, 160, 500);
+    put(neg, 60, 128, 128, 1000);
+    pp[0] = a; pp[1] = b;
+    cyl_colortable_init(t);
+    /* a box class at index 1 stays as it is */
+    cyl_colortable_add_box(t, 1, 0, 255, 100, 103, 160, 163);
+    p.bg_uniform_weight = 0.5;   /* finite ratios: a's at s is 0.2/bg, b's 0.5/bg */
+    assert_int_equal(cyl_colortable_learn(t, cls, pp, 2, neg, &p, work, ws, r), CYL_OK);
+    assert_float_equal(r[0].recall_alone, 1.0, 1e-12);
+    assert_float_equal(r[0].recall, 0.8, 1e-12);
+    assert_float_equal(r[0].lost_to[5], 0.2, 1e-12);
+    assert_float_equal(r[1].recall, 1.0, 1e-12);
+    assert_float_equal(r[1].lost_to[0], 0.0, 1e-12);
+    assert_int_equal(cyl_colortable_mask(t, 150, 100, 160), (1u << 5) | (1u << 1));
+    assert_int_equal(cyl_colortable_mask(t, 150, 80, 180), 1u << 0);
+    assert_int_equal(cyl_colortable_mask(t, 20, 100, 160), 1u << 1);   /* box class: every brightness */
+    /* errors */
+    cls[1] = 0;
+    assert_int_equal(cyl_colortable_learn(t, cls, pp, 2, neg, &p, work, ws, r), CYL_ERR_ARG);
+    cls[1] = 8;
+    assert_int_equal(cyl_colortable_learn(t, cls, pp, 2, neg, &p, work, ws, r), CYL_ERR_CLASS);
+    cls[1] = 5;
+    assert_int_equal(cyl_colortable_learn(t, cls, pp, 2, neg, &p, work, ws - 1, r), CYL_ERR_NOMEM);
+    p.max_bg_fraction = 1.5;
+    assert_int_equal(cyl_colortable_learn(t, cls, pp, 2, neg, &p, work, ws, r), CYL_ERR_ARG);
+    p.max_bg_fraction = 0.01;
+    cyl_colorhist_clear(neg);
+    assert_int_equal(cyl_colortable_learn(t, cls, pp, 2, neg, &p, work, ws, r), CYL_ERR_EMPTY);
+    free(a); free(b); free(neg); free(t); free(work);
+}
+
+/* A colour whose chroma moves with brightness (a shaded ball: pale when lit, saturated
+ * and dark in shadow) against a background that has the lit chroma in the dark and the
+ * dark chroma when lit. No chroma rectangle with a brightness window separates them;
+ * the 3-D table does. Rendered frames through the histogram, with smoothing on. */
+static void test_brightness_dependent_chroma(void **state)
+{
+    canvas c;
+    cyl_image img;
+    uint8_t *buf, *mask;
+    size_t cap;
+    cyl_colorhist *pos = hist_new(), *neg = hist_new();
+    cyl_colortable *t = malloc(sizeof *t);
+    const cyl_colorhist *pp[1];
+    unsigned cls = 0, i;
+    size_t ws = cyl_learn_workspace_size(1);
+    void *work = malloc(ws);
+    cyl_learn_report r;
+    test_rng rng;
+    (void)state;
+    test_rng_seed(&rng, 7);
+    assert_true(canvas_alloc(&c, 64, 64));
+    mask = calloc(64 * 64, 1);
+    canvas_fill(&c, 128, 128, 128);
+    canvas_rect(&c, 0, 0, 32, 16, 200, 110, 150);    /* lit object:   Y 200, U 110, V 150 */
+    canvas_rect(&c, 0, 16, 32, 16, 70, 90, 175);     /* shaded object: Y 70, U 90, V 175 */
+    canvas_rect(&c, 32, 0, 32, 16, 70, 110, 150);    /* background: the lit chroma, dark */
+    canvas_rect(&c, 32, 16, 32, 16, 200, 90, 175);   /* background: the shaded chroma, lit */
+    canvas_noise(&c, &rng, 2.0, 2.0);
+    for (i = 0; i < 64 * 32; i++) mask[i] = (i % 64) < 32;   /* object = left half of rows 0..31 */
+    cap = canvas_format_size(&c, CYL_FMT_YUV444P, 0);
+    buf = malloc(cap);
+    assert_true(canvas_to_format(&c, CYL_FMT_YUV444P, 0, 0, buf, cap, &img));
+    assert_int_equal(cyl_colorhist_add(pos, &img, NULL, mask, 64, 1), CYL_OK);
+    assert_int_equal(cyl_colorhist_add(neg, &img, NULL, mask, 64, 0), CYL_OK);
+    assert_int_equal(pos->total + neg->total, 64 * 64);
+    pp[0] = pos;
+    cyl_colortable_init(t);
+    assert_int_equal(cyl_colortable_learn(t, &cls, pp, 1, neg, NULL, work, ws, &r), CYL_OK);
+    assert_true(r.recall > 0.99);
+    assert_true(r.bg_fraction < 0.001);
+    assert_float_equal(r.grey_fraction, 0.0, 0);
+    assert_int_equal(cyl_colortable_mask(t, 200, 110, 150), 1);
+    assert_int_equal(cyl_colortable_mask(t, 70, 90, 175), 1);
+    assert_int_equal(cyl_colortable_mask(t, 70, 110, 150), 0);
+    assert_int_equal(cyl_colortable_mask(t, 200, 90, 175), 0);
+    assert_int_equal(cyl_colortable_mask(t, 128, 128, 128), 0);
+    /* smoothing generalises to a slightly brighter lit object (one cell up) */
+    assert_int_equal(cyl_colortable_mask(t, 209, 110, 150), 1);
+    canvas_free(&c);
+    free(buf); free(mask); free(pos); free(neg); free(t); free(work);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_hist_add),
+        cmocka_unit_test(test_rate_decides_hand_derived),
+        cmocka_unit_test(test_overlap_resolved_by_ratio),
+        cmocka_unit_test(test_brightness_dependent_chroma),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
