@@ -15,13 +15,29 @@ void cyl_colorhist_clear(cyl_colorhist *h)
     if (h) memset(h, 0, sizeof *h);
 }
 
+static uint8_t scale_level(uint8_t v, double centre, double gain)
+{
+    double x = centre + gain * ((double)v - centre);
+    if (x < 0.0) return 0;
+    if (x > 255.0) return 255;
+    return (uint8_t)floor(x + 0.5);
+}
+
 cyl_status cyl_colorhist_add(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
                              const uint8_t *mask, size_t mask_stride, uint8_t mask_value)
+{
+    return cyl_colorhist_add_scaled(h, img, roi, mask, mask_stride, mask_value, 1.0);
+}
+
+cyl_status cyl_colorhist_add_scaled(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
+                                    const uint8_t *mask, size_t mask_stride, uint8_t mask_value,
+                                    double gain)
 {
     cyl_roi r;
     uint32_t x, y;
     cyl_status s;
-    if (!h) return CYL_ERR_ARG;
+    const int scaled = gain != 1.0;
+    if (!h || !(gain > 0.0 && gain <= 16.0)) return CYL_ERR_ARG;
     s = cyl_image_check(img);
     if (s != CYL_OK) return s;
     if (mask && mask_stride < img->width) return CYL_ERR_SIZE;
@@ -33,6 +49,11 @@ cyl_status cyl_colorhist_add(cyl_colorhist *h, const cyl_image *img, const cyl_r
             uint32_t *c;
             if (m && m[x] != mask_value) continue;
             cyl_pixel_fetch(img, x, y, &Y, &U, &V);
+            if (scaled) {
+                Y = scale_level(Y, 0.0, gain);
+                U = scale_level(U, 128.0, gain);
+                V = scale_level(V, 128.0, gain);
+            }
             c = &h->count[cyl_yuv_cell(Y, U, V)];
             if (*c != UINT32_MAX) { (*c)++; h->total++; }
         }
@@ -48,6 +69,8 @@ cyl_learn_params cyl_learn_params_default(void)
     p.bg_uniform_weight = 0.02;
     p.min_likelihood_ratio = 4.0;
     p.min_positive_count = 0.5;
+    p.weak_bg_fraction = 0.02;
+    p.min_weak_ratio = 1.0;
     return p;
 }
 
@@ -114,37 +137,97 @@ static double claimed_bg(const float *lr, const float *bg, float thr)
     return s;
 }
 
-cyl_status cyl_colortable_learn(cyl_colortable *t, const unsigned *cls,
-                                const cyl_colorhist *const *positive, unsigned n,
+/* Lowest threshold >= floor whose claimed background stays within rate (claimed_bg
+ * falls as the threshold rises: bisection in log space). Cells strictly above it are
+ * claimed. */
+static float rate_threshold(const float *L, const float *bg, double floor_ratio, double maxlr, double rate)
+{
+    double lo = floor_ratio > 1e-30 ? floor_ratio : 1e-30, hi;
+    int it;
+    float thr;
+    if (claimed_bg(L, bg, (float)lo) <= rate || lo >= maxlr) {
+        thr = (float)lo;
+    } else {
+        lo = log(lo);
+        hi = log(maxlr);
+        for (it = 0; it < 60; it++) {
+            double mid = 0.5 * (lo + hi);
+            if (claimed_bg(L, bg, (float)exp(mid)) <= rate) hi = mid;
+            else lo = mid;
+        }
+        thr = (float)exp(hi);
+    }
+    /* a threshold at the floor keeps the cells at the floor itself */
+    if ((double)thr <= floor_ratio) thr = (float)(floor_ratio * (1.0 - 1e-6));
+    return thr;
+}
+
+static void set_cells(cyl_colortable *t, unsigned cls, const float *L, float lo, float hi)
+{
+    const cyl_mask bit = (cyl_mask)(1u << cls);
+    cyl_mask *cell = &t->yuv[0][0][0];
+    unsigned u, v, yv, c;
+    cyl_colortable_clear_class(t, cls);
+    for (yv = 0; yv < 256; yv++) t->y[yv] |= bit;
+    for (c = 0; c < K; c++)
+        if (!(L[c] > lo && L[c] <= hi)) cell[c] &= (cyl_mask)~bit;
+    for (u = 0; u < NC; u++)
+        for (v = 0; v < NC; v++) {
+            int any = 0;
+            unsigned yc, du, dv;
+            for (yc = 0; yc < NY && !any; yc++) any = (t->yuv[yc][u][v] & bit) != 0;
+            if (!any) continue;
+            for (du = 0; du < (1u << CYL_YUV_CSHIFT); du++)
+                for (dv = 0; dv < (1u << CYL_YUV_CSHIFT); dv++)
+                    t->uv[(u << CYL_YUV_CSHIFT) + du][(v << CYL_YUV_CSHIFT) + dv] |= bit;
+        }
+}
+
+cyl_status cyl_colortable_learn(cyl_colortable *t, const cyl_learn_class *classes, unsigned n,
                                 const cyl_colorhist *negative, const cyl_learn_params *params,
                                 void *work, size_t work_size, cyl_learn_report *reports)
 {
     cyl_learn_params p = params ? *params : cyl_learn_params_default();
     float *bg, *tmp, *lr[CYL_MAX_CLASSES];
-    float thr[CYL_MAX_CLASSES];
-    unsigned i, j, c;
+    float thr[CYL_MAX_CLASSES], wthr[CYL_MAX_CLASSES];
+    unsigned i, j, c, used = 0;
     double eps, nneg;
 
-    if (!t || !cls || !positive || !negative || n == 0) return CYL_ERR_ARG;
+    if (!t || !classes || !negative || n == 0) return CYL_ERR_ARG;
     if (n > CYL_MAX_CLASSES) return CYL_ERR_ARG;
     if (!(p.max_bg_fraction >= 0.0 && p.max_bg_fraction <= 1.0) ||
         !(p.smooth_sigma_cells >= 0.0 && p.smooth_sigma_cells <= 2.0) ||
         !(p.bg_uniform_weight >= 0.0 && p.bg_uniform_weight <= 1.0) ||
         !(p.min_likelihood_ratio >= 0.0 && p.min_likelihood_ratio < 1e30) ||
-        !(p.min_positive_count >= 0.0 && p.min_positive_count < 1e30))
+        !(p.min_positive_count >= 0.0 && p.min_positive_count < 1e30) ||
+        !(p.weak_bg_fraction >= p.max_bg_fraction && p.weak_bg_fraction <= 1.0) ||
+        !(p.min_weak_ratio >= 0.0 && p.min_weak_ratio <= p.min_likelihood_ratio))
         return CYL_ERR_ARG;
     for (i = 0; i < n; i++) {
-        if (cls[i] >= CYL_MAX_CLASSES) return CYL_ERR_CLASS;
-        if (!positive[i]) return CYL_ERR_ARG;
-        for (j = 0; j < i; j++)
-            if (cls[j] == cls[i]) return CYL_ERR_ARG;
+        const cyl_learn_class *k = &classes[i];
+        if (k->cls >= CYL_MAX_CLASSES) return CYL_ERR_CLASS;
+        if (k->weak_cls >= CYL_MAX_CLASSES && k->weak_cls != CYL_CLASS_NONE) return CYL_ERR_CLASS;
+        if (!k->positive) return CYL_ERR_ARG;
+        if (used & (1u << k->cls)) return CYL_ERR_ARG;
+        used |= 1u << k->cls;
+        if (k->weak_cls != CYL_CLASS_NONE) {
+            if (used & (1u << k->weak_cls)) return CYL_ERR_ARG;
+            used |= 1u << k->weak_cls;
+        }
+    }
+    /* a class not learned here must not be the weak evidence of one that is (its
+     * relation would dangle), nor have one of these as its weak class */
+    for (j = 0; j < CYL_MAX_CLASSES; j++) {
+        unsigned w = t->weak_of[j];
+        if (used & (1u << j)) continue;
+        if (w < CYL_MAX_CLASSES && (used & (1u << w))) return CYL_ERR_ARG;
     }
     if (!work) return CYL_ERR_ARG;
     if (work_size < cyl_learn_workspace_size(n) || ((uintptr_t)work % sizeof(float)) != 0)
         return CYL_ERR_NOMEM;
     if (negative->total == 0) return CYL_ERR_EMPTY;
     for (i = 0; i < n; i++)
-        if (positive[i]->total == 0) return CYL_ERR_EMPTY;
+        if (classes[i].positive->total == 0) return CYL_ERR_EMPTY;
 
     bg = (float *)work;
     tmp = bg + K;
@@ -157,125 +240,113 @@ cyl_status cyl_colortable_learn(cyl_colortable *t, const unsigned *cls,
     for (c = 0; c < K; c++)
         bg[c] = (float)((1.0 - eps) * (double)bg[c] / nneg + eps / (double)K);
 
-    /* Per class: likelihood ratio, then the threshold the false-positive rate allows. */
+    /* Per class: likelihood ratio, then the thresholds the false-positive rates allow. */
     for (i = 0; i < n; i++) {
-        double npos = (double)positive[i]->total, lo, hi, maxlr = 0.0;
+        const cyl_colorhist *pos = classes[i].positive;
+        double npos = (double)pos->total, maxlr = 0.0;
+        double floor_ratio = classes[i].weak_cls != CYL_CLASS_NONE ? p.min_weak_ratio : p.min_likelihood_ratio;
         float *L = lr[i];
-        int it;
-        smoothed(positive[i], L, p.smooth_sigma_cells);
+        uint32_t kept = 0;
+        smoothed(pos, L, p.smooth_sigma_cells);
         for (c = 0; c < K; c++) {
             double cnt = (double)L[c], v = 0.0;
             if (cnt >= p.min_positive_count && cnt > 0.0) {
                 /* no background density at all (only without the uniform part): certain */
                 v = bg[c] > 0.0f ? (cnt / npos) / (double)bg[c] : 1e30;
-                if (v < p.min_likelihood_ratio) v = 0.0;
+                if (v < floor_ratio) v = 0.0;
             }
             L[c] = (float)v;
             if (v > maxlr) maxlr = v;
         }
         if (maxlr <= 0.0) return CYL_ERR_EMPTY;
-        /* Lowest threshold (>= min ratio) whose claimed background stays within the rate:
-         * claimed_bg falls as the threshold rises; bisect in log space. */
-        lo = p.min_likelihood_ratio > 1e-30 ? p.min_likelihood_ratio : 1e-30;
-        if (claimed_bg(L, bg, (float)lo) * (1.0 + 1e-9) <= p.max_bg_fraction || lo >= maxlr) {
-            thr[i] = (float)lo;
-        } else {
-            lo = log(lo);
-            hi = log(maxlr);
-            for (it = 0; it < 60; it++) {
-                double mid = 0.5 * (lo + hi);
-                if (claimed_bg(L, bg, (float)exp(mid)) <= p.max_bg_fraction) hi = mid;
-                else lo = mid;
-            }
-            thr[i] = (float)exp(hi);
-        }
-        /* strictly-greater comparisons below; a threshold at the min ratio keeps cells at it */
-        if ((double)thr[i] <= p.min_likelihood_ratio) thr[i] = (float)(p.min_likelihood_ratio * (1.0 - 1e-6));
-        {
-            uint32_t kept = 0;
-            for (c = 0; c < K; c++) kept += L[c] > thr[i];
-            if (kept == 0) return CYL_ERR_EMPTY;
-        }
+        thr[i] = rate_threshold(L, bg, p.min_likelihood_ratio, maxlr, p.max_bg_fraction);
+        wthr[i] = classes[i].weak_cls != CYL_CLASS_NONE
+                      ? rate_threshold(L, bg, p.min_weak_ratio, maxlr, p.weak_bg_fraction) : thr[i];
+        if (wthr[i] > thr[i]) wthr[i] = thr[i];
+        for (c = 0; c < K; c++) kept += L[c] > thr[i];
+        if (kept == 0) return CYL_ERR_EMPTY;
     }
 
     /* Reports before resolution, then resolution: a cell claimed by several keeps the
-     * class with the largest ratio. */
+     * class with the largest ratio among those claiming it as their own, else among the
+     * weak claims. Losers' ratios become 0. */
     if (reports) {
         for (i = 0; i < n; i++) {
             cyl_learn_report *r = &reports[i];
             uint64_t alone = 0;
             memset(r, 0, sizeof *r);
             r->lr_threshold = thr[i];
+            r->weak_lr_threshold = classes[i].weak_cls != CYL_CLASS_NONE ? wthr[i] : 0.0;
             for (c = 0; c < K; c++)
-                if (lr[i][c] > thr[i]) alone += positive[i]->count[c];
-            r->recall_alone = (double)alone / (double)positive[i]->total;
+                if (lr[i][c] > thr[i]) alone += classes[i].positive->count[c];
+            r->recall_alone = (double)alone / (double)classes[i].positive->total;
         }
     }
     for (c = 0; c < K; c++) {
         unsigned best = n;
         float bestv = 0.0f;
-        unsigned nclaim = 0;
-        for (i = 0; i < n; i++)
-            if (lr[i][c] > thr[i]) {
-                nclaim++;
-                if (best == n || lr[i][c] > bestv) { best = i; bestv = lr[i][c]; }
-            }
-        if (nclaim > 1 && reports)
-            for (i = 0; i < n; i++)
-                if (i != best && lr[i][c] > thr[i])
-                    reports[i].lost_to[cls[best]] += (double)positive[i]->count[c];
-        /* keep the winner's ratio; the losers' become 0 (tmp marks nothing here) */
-        for (i = 0; i < n; i++)
-            if (i != best) lr[i][c] = 0.0f;
+        int strong = 0;
+        for (i = 0; i < n; i++) {
+            const float v = lr[i][c];
+            const int s_i = v > thr[i];
+            if (!(v > wthr[i])) continue;
+            if (best == n || s_i > strong || (s_i == strong && v > bestv)) { best = i; bestv = v; strong = s_i; }
+        }
+        if (best == n) continue;
+        for (i = 0; i < n; i++) {
+            if (i == best || !(lr[i][c] > wthr[i])) continue;
+            if (reports && lr[i][c] > thr[i]) reports[i].lost_to[classes[best].cls] += (double)classes[i].positive->count[c];
+            lr[i][c] = 0.0f;
+        }
     }
 
     /* Write the classes into the table. */
     for (i = 0; i < n; i++) {
-        const cyl_mask bit = (cyl_mask)(1u << cls[i]);
-        cyl_mask *cell = &t->yuv[0][0][0];
-        unsigned u, v, yv;
-        cyl_colortable_clear_class(t, cls[i]);
-        for (yv = 0; yv < 256; yv++) t->y[yv] |= bit;
-        for (c = 0; c < K; c++)
-            if (!(lr[i][c] > thr[i])) cell[c] &= (cyl_mask)~bit;
-        for (u = 0; u < NC; u++)
-            for (v = 0; v < NC; v++) {
-                int any = 0;
-                unsigned yc, du, dv;
-                for (yc = 0; yc < NY && !any; yc++) any = (t->yuv[yc][u][v] & bit) != 0;
-                if (!any) continue;
-                for (du = 0; du < (1u << CYL_YUV_CSHIFT); du++)
-                    for (dv = 0; dv < (1u << CYL_YUV_CSHIFT); dv++)
-                        t->uv[(u << CYL_YUV_CSHIFT) + du][(v << CYL_YUV_CSHIFT) + dv] |= bit;
-            }
+        const unsigned w = classes[i].weak_cls;
+        set_cells(t, classes[i].cls, lr[i], thr[i], 3.4e38f);
+        cyl_colortable_set_weak(t, classes[i].cls, CYL_CLASS_NONE);
+        if (w != CYL_CLASS_NONE) {
+            set_cells(t, w, lr[i], wthr[i], thr[i]);
+            cyl_colortable_set_weak(t, w, CYL_CLASS_NONE);
+        }
     }
-
+    for (i = 0; i < n; i++)
+        if (classes[i].weak_cls != CYL_CLASS_NONE) cyl_colortable_set_weak(t, classes[i].weak_cls, classes[i].cls);
     cyl_colortable_refresh(t);
 
     if (reports) {
         for (i = 0; i < n; i++) {
             cyl_learn_report *r = &reports[i];
-            uint64_t kept_pos = 0, kept_neg = 0;
-            uint32_t cells = 0, grey = 0;
+            const cyl_colorhist *pos = classes[i].positive;
+            uint64_t kept_pos = 0, kept_neg = 0, weak_pos = 0, weak_neg = 0;
+            uint32_t cells = 0, grey = 0, wcells = 0;
             for (c = 0; c < K; c++) {
                 unsigned u, v;
-                if (!(lr[i][c] > thr[i])) continue;
-                cells++;
-                kept_pos += positive[i]->count[c];
-                kept_neg += negative->count[c];
-                u = (c / NC) % NC;
-                v = c % NC;
-                {
-                    /* cell centre in 8-bit chroma */
-                    double uc = (u + 0.5) * (1u << CYL_YUV_CSHIFT), vc = (v + 0.5) * (1u << CYL_YUV_CSHIFT);
-                    if (fabs(uc - 128.0) <= 8.0 && fabs(vc - 128.0) <= 8.0) grey++;
+                if (lr[i][c] > thr[i]) {
+                    cells++;
+                    kept_pos += pos->count[c];
+                    kept_neg += negative->count[c];
+                    u = (c / NC) % NC;
+                    v = c % NC;
+                    {
+                        /* cell centre in 8-bit chroma */
+                        double uc = (u + 0.5) * (1u << CYL_YUV_CSHIFT), vc = (v + 0.5) * (1u << CYL_YUV_CSHIFT);
+                        if (fabs(uc - 128.0) <= 8.0 && fabs(vc - 128.0) <= 8.0) grey++;
+                    }
+                } else if (classes[i].weak_cls != CYL_CLASS_NONE && lr[i][c] > wthr[i]) {
+                    wcells++;
+                    weak_pos += pos->count[c];
+                    weak_neg += negative->count[c];
                 }
             }
             r->cells = cells;
-            r->recall = (double)kept_pos / (double)positive[i]->total;
+            r->recall = (double)kept_pos / (double)pos->total;
             r->bg_fraction = (double)kept_neg / nneg;
             r->grey_fraction = cells ? (double)grey / (double)cells : 0.0;
-            for (j = 0; j < CYL_MAX_CLASSES; j++) r->lost_to[j] /= (double)positive[i]->total;
+            r->weak_cells = wcells;
+            r->weak_recall = (double)weak_pos / (double)pos->total;
+            r->weak_bg_fraction = (double)weak_neg / nneg;
+            for (j = 0; j < CYL_MAX_CLASSES; j++) r->lost_to[j] /= (double)pos->total;
         }
     }
     return CYL_OK;

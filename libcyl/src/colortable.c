@@ -10,6 +10,7 @@ void cyl_colortable_init(cyl_colortable *t)
     memset(t, 0, sizeof *t);
     memset(t->yuv, 0xFF, sizeof t->yuv);
     t->lookup = CYL_LOOKUP_UV_Y;
+    memset(t->weak_of, CYL_CLASS_NONE, sizeof t->weak_of);
     for (i = 0; i < CYL_MAX_CLASSES; i++) t->rgb[i][0] = t->rgb[i][1] = t->rgb[i][2] = 128;
 }
 
@@ -33,6 +34,28 @@ int cyl_colortable_find_class(const cyl_colortable *t, const char *name)
     for (i = 0; i < CYL_MAX_CLASSES; i++)
         if (strncmp(t->name[i], name, CYL_CLASS_NAME_LEN) == 0) return (int)i;
     return -1;
+}
+
+cyl_status cyl_colortable_set_weak(cyl_colortable *t, unsigned weak, unsigned strong)
+{
+    unsigned i;
+    if (!t) return CYL_ERR_ARG;
+    if (weak >= CYL_MAX_CLASSES || (strong >= CYL_MAX_CLASSES && strong != CYL_CLASS_NONE)) return CYL_ERR_CLASS;
+    if (strong != CYL_CLASS_NONE) {
+        if (strong == weak || t->weak_of[strong] != CYL_CLASS_NONE) return CYL_ERR_ARG;
+        for (i = 0; i < CYL_MAX_CLASSES; i++)
+            if (t->weak_of[i] == weak) return CYL_ERR_ARG;   /* weak has a weak class itself */
+    }
+    t->weak_of[weak] = (uint8_t)strong;
+    return CYL_OK;
+}
+
+static int has_weak(const cyl_colortable *t)
+{
+    unsigned i;
+    for (i = 0; i < CYL_MAX_CLASSES; i++)
+        if (t->weak_of[i] != CYL_CLASS_NONE) return 1;
+    return 0;
 }
 
 cyl_status cyl_colortable_clear_class(cyl_colortable *t, unsigned cls)
@@ -289,7 +312,7 @@ cyl_status cyl_colortable_save(const cyl_colortable *t, uint8_t *buf, size_t cap
     unsigned i;
     int v2;
     if (!t || !buf) return CYL_ERR_ARG;
-    v2 = cyl_colortable_has_yuv(t);
+    v2 = cyl_colortable_has_yuv(t) || has_weak(t);
     if (cap < (v2 ? CYL_TABLE_FILE_SIZE_V2 : CYL_TABLE_FILE_SIZE)) return CYL_ERR_NOMEM;
     memcpy(buf, "CYLT", 4);
     cyl_put_u16(buf + 4, (uint16_t)(v2 ? CYL_TABLE_FILE_VERSION_V2 : CYL_TABLE_FILE_VERSION));
@@ -301,6 +324,7 @@ cyl_status cyl_colortable_save(const cyl_colortable *t, uint8_t *buf, size_t cap
         memset(rec, 0, CLASS_REC);
         for (k = 0; k < CYL_CLASS_NAME_LEN - 1u && t->name[i][k]; k++) rec[k] = (uint8_t)t->name[i][k];
         memcpy(rec + CYL_CLASS_NAME_LEN, t->rgb[i], 3);
+        if (v2) rec[CLASS_REC - 1u] = (uint8_t)(t->weak_of[i] == CYL_CLASS_NONE ? 0u : t->weak_of[i] + 1u);
     }
     memcpy(buf + OFF_Y, t->y, 256);
     memcpy(buf + OFF_UV, t->uv, 65536);
@@ -341,12 +365,24 @@ cyl_status cyl_colortable_load(cyl_colortable *t, const uint8_t *buf, size_t len
         int terminated = 0;
         for (k = 0; k < CYL_CLASS_NAME_LEN; k++)
             if (rec[k] == 0) { terminated = 1; break; }
-        if (!terminated || rec[CLASS_REC - 1u] != 0) return CYL_ERR_FILE_CORRUPT;
+        if (!terminated) return CYL_ERR_FILE_CORRUPT;
+        if (version == CYL_TABLE_FILE_VERSION ? rec[CLASS_REC - 1u] != 0 : rec[CLASS_REC - 1u] > CYL_MAX_CLASSES)
+            return CYL_ERR_FILE_CORRUPT;
         for (; k < CYL_CLASS_NAME_LEN; k++)
             if (rec[k] != 0) return CYL_ERR_FILE_CORRUPT; /* padding must be zero */
     }
+    if (version == CYL_TABLE_FILE_VERSION_V2) {
+        /* weak classes: not their own, and one level only */
+        for (i = 0; i < CYL_MAX_CLASSES; i++) {
+            unsigned w = buf[OFF_CLASSES + i * CLASS_REC + CLASS_REC - 1u];
+            if (w == 0) continue;
+            if (w - 1u == i || buf[OFF_CLASSES + (w - 1u) * CLASS_REC + CLASS_REC - 1u] != 0) return CYL_ERR_FILE_CORRUPT;
+        }
+    }
     for (i = 0; i < CYL_MAX_CLASSES; i++) {
         const uint8_t *rec = buf + OFF_CLASSES + i * CLASS_REC;
+        t->weak_of[i] = (uint8_t)(version == CYL_TABLE_FILE_VERSION || rec[CLASS_REC - 1u] == 0
+                                      ? CYL_CLASS_NONE : rec[CLASS_REC - 1u] - 1u);
         memcpy(t->name[i], rec, CYL_CLASS_NAME_LEN);
         memcpy(t->rgb[i], rec + CYL_CLASS_NAME_LEN, 3);
     }

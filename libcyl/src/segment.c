@@ -26,6 +26,7 @@ typedef struct blob_acc {
     int64_t n, sx, sy, sxx, syy, sxy;
     uint32_t last_run;   /* tail of the blob's run list */
     uint32_t alive;      /* 0 once merged into another blob or dropped */
+    uint32_t strong;     /* 1 if some run is of the blob's own class (not a weak one) */
 } blob_acc;
 
 cyl_segment_params cyl_segment_params_default(void)
@@ -294,16 +295,27 @@ static void uf_union(cyl_run *r, uint32_t a, uint32_t b)
     else if (b < a) r[a].blob = b;
 }
 
-/* Join runs of the previous sampled row [pb, pe) with the current one [cb, ce). */
-static void connect_rows(cyl_run *r, uint32_t pb, uint32_t pe, uint32_t cb, uint32_t ce, uint32_t xs)
+/* Join runs of the previous sampled row [pb, pe) with the current one [cb, ce).
+ * eq: each class's blob class (itself, or the class it is weak evidence of). */
+static void connect_rows(cyl_run *r, uint32_t pb, uint32_t pe, uint32_t cb, uint32_t ce, uint32_t xs,
+                         const uint8_t *eq)
 {
     uint32_t i = pb, j = cb;
     while (i < pe && j < ce) {
         uint32_t a0 = r[i].x, a1 = a0 + (uint32_t)(r[i].width - 1u) * xs;
         uint32_t b0 = r[j].x, b1 = b0 + (uint32_t)(r[j].width - 1u) * xs;
-        if (a0 <= b1 && b0 <= a1 && r[i].cls == r[j].cls) uf_union(r, i, j);
+        if (a0 <= b1 && b0 <= a1 && eq[r[i].cls] == eq[r[j].cls]) uf_union(r, i, j);
         if (a1 < b1) i++; else j++;
     }
+}
+
+/* With weak classes: join side-by-side runs of a row [cb, ce) whose blob classes agree. */
+static void connect_within_row(cyl_run *r, uint32_t cb, uint32_t ce, uint32_t xs, const uint8_t *eq)
+{
+    uint32_t j;
+    for (j = cb + 1u; j < ce; j++)
+        if (r[j].x == r[j - 1u].x + (uint32_t)r[j - 1u].width * xs && eq[r[j].cls] == eq[r[j - 1u].cls])
+            uf_union(r, j - 1u, j);
 }
 
 /* ---- blobs ------------------------------------------------------------------ */
@@ -364,6 +376,7 @@ static int try_merge(cyl_segmentation *seg, blob_acc *acc, uint32_t ia, uint32_t
     /* b joins a */
     acc[ia].n += acc[ib].n; acc[ia].sx += acc[ib].sx; acc[ia].sy += acc[ib].sy;
     acc[ia].sxx += acc[ib].sxx; acc[ia].syy += acc[ib].syy; acc[ia].sxy += acc[ib].sxy;
+    acc[ia].strong |= acc[ib].strong;
     acc[ib].alive = 0;
     a->first_run = merge_lists(seg->runs, a->first_run, b->first_run, &acc[ia].last_run);
     a->n_runs += b->n_runs;
@@ -472,6 +485,8 @@ cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
     blob_acc *acc;
     cyl_run *runs;
     uint32_t xs, ys, nx, y, prev_b = 0, prev_e = 0, i, nb = 0, k;
+    uint8_t eq[CYL_MAX_CLASSES];
+    int weak = 0;
     cyl_status s;
 
     if (!t || !seg || !seg->runs || !seg->blobs || !seg->work) return CYL_ERR_ARG;
@@ -503,6 +518,12 @@ cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
         seg->merge_gap_px[k] = p->cls[k].merge_gap_px;
     }
 
+    for (k = 0; k < CYL_MAX_CLASSES; k++) {
+        unsigned w = t->weak_of[k];
+        eq[k] = (uint8_t)(w < CYL_MAX_CLASSES && t->weak_of[w] == CYL_CLASS_NONE ? w : k);
+        weak |= eq[k] != k;
+    }
+
     /* 1. classify + run-length encode, connecting each row to the previous one */
     runs = seg->runs;
     ctx.runs = runs;
@@ -513,7 +534,8 @@ cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
     for (y = r.y; y < r.y + r.height; y += ys) {
         uint32_t b = ctx.n;
         int ok = encode_row(&ctx, t, img, y, r.x, xs, nx);
-        connect_rows(runs, prev_b, prev_e, b, ctx.n, xs);
+        if (weak) connect_within_row(runs, b, ctx.n, xs, eq);
+        connect_rows(runs, prev_b, prev_e, b, ctx.n, xs, eq);
         prev_b = b;
         prev_e = ctx.n;
         if (!ok) break;
@@ -549,7 +571,7 @@ cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
         xe = rn->x + (uint32_t)(rn->width - 1u) * xs;
         if (acc[bi].n == 0) {
             memset(b, 0, sizeof *b);
-            b->cls = rn->cls;
+            b->cls = eq[rn->cls];
             b->n_components = 1;
             b->x0 = rn->x; b->x1 = (uint16_t)xe; b->y0 = rn->y; b->y1 = rn->y;
             b->first_run = i;
@@ -560,6 +582,7 @@ cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
             b->y1 = rn->y;
         }
         acc[bi].last_run = i;
+        acc[bi].strong |= rn->cls == b->cls;
         b->n_runs++;
         acc_add_run(&acc[bi], rn, xs);
     }
@@ -569,6 +592,7 @@ cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
     k = 0;
     for (i = 0; i < nb; i++) {
         if (!acc[i].alive || acc[i].n < (int64_t)p->cls[seg->blobs[i].cls].min_area) continue;
+        if (weak && !acc[i].strong) continue;   /* weak evidence alone is no blob */
         if (k != i) seg->blobs[k] = seg->blobs[i];
         finish_blob(seg, &seg->blobs[k], &acc[i]);
         k++;

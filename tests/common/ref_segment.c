@@ -18,7 +18,8 @@ int ref_segment(const cyl_colortable *t, const cyl_image *img, const cyl_segment
 {
     uint32_t rx = p->roi.x, ry = p->roi.y, rw = p->roi.width, rh = p->roi.height;
     uint32_t xs = p->x_step, ys = p->y_step, nx, ny, i, j;
-    int *cls, *lab, *stack, nb = 0, nout = 0, a, b;
+    int *cls, *lab, *stack, nb = 0, nout = 0, a, b, weak = 0, has_strong = 0;
+    char *strong_px;
     ref_blob *all;
     if (rw == 0 || rh == 0) { rx = 0; ry = 0; rw = img->width; rh = img->height; }
     nx = (rw + xs - 1) / xs;
@@ -27,7 +28,8 @@ int ref_segment(const cyl_colortable *t, const cyl_image *img, const cyl_segment
     lab = (int *)malloc(sizeof(int) * nx * ny);
     stack = (int *)malloc(sizeof(int) * nx * ny);
     all = (ref_blob *)malloc(sizeof(ref_blob) * nx * ny);
-    if (!cls || !lab || !stack || !all) { free(cls); free(lab); free(stack); free(all); return -1; }
+    strong_px = (char *)malloc(nx * ny);
+    if (!cls || !lab || !stack || !all || !strong_px) { free(cls); free(lab); free(stack); free(all); free(strong_px); return -1; }
     for (j = 0; j < ny; j++)
         for (i = 0; i < nx; i++) {
             uint8_t Y, U, V;
@@ -49,6 +51,18 @@ int ref_segment(const cyl_colortable *t, const cyl_image *img, const cyl_segment
             i = e;
         }
     }
+    /* weak classes (hysteresis): a weak pixel belongs to its strong class's blobs; remember
+     * which pixels are strong in the sign of a second array (stack is free until the fill) */
+    for (i = 0; i < nx * ny; i++) {
+        int c0 = cls[i];
+        stack[i] = 1;
+        if (c0 >= 0 && t->weak_of[c0] < 8 && t->weak_of[t->weak_of[c0]] == CYL_CLASS_NONE) {
+            cls[i] = t->weak_of[c0];
+            stack[i] = 0;
+            weak = 1;
+        }
+    }
+    for (i = 0; i < nx * ny; i++) strong_px[i] = (char)stack[i];
     for (i = 0; i < nx * ny; i++) lab[i] = -1;
     for (j = 0; j < ny; j++)
         for (i = 0; i < nx; i++) {
@@ -56,6 +70,7 @@ int ref_segment(const cyl_colortable *t, const cyl_image *img, const cyl_segment
             ref_blob *rb;
             double n, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
             if (cls[s0] < 0 || lab[s0] >= 0) continue;
+            has_strong = 0;
             rb = &all[nb];
             memset(rb, 0, sizeof *rb);
             rb->cls = (unsigned)cls[s0];
@@ -68,6 +83,7 @@ int ref_segment(const cyl_colortable *t, const cyl_image *img, const cyl_segment
                 uint32_t si = (uint32_t)s % nx, sj = (uint32_t)s / nx;
                 double X = rx + si * xs, Yc = ry + sj * ys;
                 rb->area++;
+                has_strong |= strong_px[s];
                 sx += X; sy += Yc; sxx += X * X; syy += Yc * Yc; sxy += X * Yc;
                 if (X < rb->x0) rb->x0 = (uint32_t)X;
                 if (X > rb->x1) rb->x1 = (uint32_t)X;
@@ -92,6 +108,7 @@ int ref_segment(const cyl_colortable *t, const cyl_image *img, const cyl_segment
             if (rb->x1 == rx + (nx - 1) * xs) rb->touches |= CYL_BLOB_TOUCH_RIGHT;
             if (rb->y0 == ry) rb->touches |= CYL_BLOB_TOUCH_TOP;
             if (rb->y1 == ry + (ny - 1) * ys) rb->touches |= CYL_BLOB_TOUCH_BOTTOM;
+            if (weak && !has_strong) rb->area = 0;   /* weak evidence alone: no blob */
             nb++;
         }
     /* filter by min_area, selection sort into out */
@@ -106,6 +123,6 @@ int ref_segment(const cyl_colortable *t, const cyl_image *img, const cyl_segment
         all[best].area = 0;
     }
     if (label_out) memcpy(label_out, lab, sizeof(int) * nx * ny);
-    free(cls); free(lab); free(stack); free(all);
+    free(cls); free(lab); free(stack); free(all); free(strong_px);
     return nout;
 }

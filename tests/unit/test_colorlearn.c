@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "cyl/colorlearn.h"
+#include "cyl/segment.h"
 #include "synth_frames.h"
 
 static cyl_colorhist *hist_new(void)
@@ -72,6 +73,19 @@ static void test_hist_add(void **state)
     roi.width = 9;
     assert_int_equal(cyl_colorhist_add(h, &img, &roi, NULL, 0, 0), CYL_ERR_SIZE);
     assert_int_equal(cyl_colorhist_add(NULL, &img, NULL, NULL, 0, 0), CYL_ERR_ARG);
+    /* scaled: (100, 60, 200) at gain 1.25 is (125, 128 - 85, 128 + 90) = (125, 43, 218);
+     * (20, 130, 131) is (25, 130.5 -> 131, 131.75 -> 132) */
+    roi.width = 3;
+    cyl_colorhist_clear(h);
+    assert_int_equal(cyl_colorhist_add_scaled(h, &img, NULL, NULL, 0, 0, 1.25), CYL_OK);
+    assert_int_equal(h->count[cyl_yuv_cell(125, 43, 218)], 24);
+    assert_int_equal(h->count[cyl_yuv_cell(25, 131, 132)], 24);
+    /* and clipped: gain 3 takes Y 100 to 255, U 60 to 0, V 200 to 255 */
+    cyl_colorhist_clear(h);
+    assert_int_equal(cyl_colorhist_add_scaled(h, &img, NULL, NULL, 0, 0, 3.0), CYL_OK);
+    assert_int_equal(h->count[cyl_yuv_cell(255, 0, 255)], 24);
+    assert_int_equal(cyl_colorhist_add_scaled(h, &img, NULL, NULL, 0, 0, 0.0), CYL_ERR_ARG);
+    assert_int_equal(cyl_colorhist_add_scaled(h, &img, NULL, NULL, 0, 0, 17.0), CYL_ERR_ARG);
     canvas_free(&c);
     free(buf); free(h);
 }
@@ -82,8 +96,7 @@ static void test_rate_decides_hand_derived(void **state)
 {
     cyl_colorhist *pos = hist_new(), *neg = hist_new();
     cyl_colortable *t = malloc(sizeof *t);
-    const cyl_colorhist *pp[1];
-    unsigned cls = 2;
+    cyl_learn_class lc = { 2, CYL_CLASS_NONE, NULL };
     size_t ws = cyl_learn_workspace_size(1);
     void *work = malloc(ws);
     cyl_learn_params p = exact_params();
@@ -93,12 +106,12 @@ static void test_rate_decides_hand_derived(void **state)
     put(pos, 120, 90, 90, 100);    /* c */
     put(neg, 120, 90, 90, 10);     /* c */
     put(neg, 60, 128, 128, 9990);  /* b */
-    pp[0] = pos;
+    lc.positive = pos;
     cyl_colortable_init(t);
     cyl_colortable_set_class(t, 2, "x", 1, 2, 3);
 
     p.max_bg_fraction = 0.0005;    /* c would claim 0.001 of the background: not allowed */
-    assert_int_equal(cyl_colortable_learn(t, &cls, pp, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_OK);
     assert_int_equal(r.cells, 1);
     assert_float_equal(r.recall, 0.9, 1e-12);
     assert_float_equal(r.recall_alone, 0.9, 1e-12);
@@ -112,7 +125,7 @@ static void test_rate_decides_hand_derived(void **state)
     assert_int_equal(t->y[0], 1u << 2);
 
     p.max_bg_fraction = 0.002;     /* now c fits */
-    assert_int_equal(cyl_colortable_learn(t, &cls, pp, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_OK);
     assert_int_equal(r.cells, 2);
     assert_float_equal(r.recall, 1.0, 1e-12);
     assert_float_equal(r.bg_fraction, 0.001, 1e-12);
@@ -120,7 +133,7 @@ static void test_rate_decides_hand_derived(void **state)
     assert_int_equal(cyl_colortable_mask(t, 120, 90, 90), 1u << 2);
 
     p.min_likelihood_ratio = 150;  /* ... unless its ratio (100) is below the floor */
-    assert_int_equal(cyl_colortable_learn(t, &cls, pp, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_OK);
     assert_int_equal(r.cells, 1);
     assert_int_equal(cyl_colortable_mask(t, 120, 90, 90), 0);
 
@@ -130,10 +143,10 @@ static void test_rate_decides_hand_derived(void **state)
     p = exact_params();
     p.bg_uniform_weight = 1.0;
     p.min_likelihood_ratio = 100000;
-    assert_int_equal(cyl_colortable_learn(t, &cls, pp, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_OK);
     assert_int_equal(r.cells, 1);
     p.min_likelihood_ratio = 120000;
-    assert_int_equal(cyl_colortable_learn(t, &cls, pp, 1, neg, &p, work, ws, &r), CYL_ERR_EMPTY);
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_ERR_EMPTY);
     free(pos); free(neg); free(t); free(work);
 }
 
@@ -142,8 +155,7 @@ static void test_overlap_resolved_by_ratio(void **state)
 {
     cyl_colorhist *a = hist_new(), *b = hist_new(), *neg = hist_new();
     cyl_colortable *t = malloc(sizeof *t);
-    const cyl_colorhist *pp[2];
-    unsigned cls[2] = { 0, 5 };
+    cyl_learn_class lc[2] = { { 0, CYL_CLASS_NONE, NULL }, { 5, CYL_CLASS_NONE, NULL } };
     size_t ws = cyl_learn_workspace_size(2);
     void *work = malloc(ws);
     cyl_learn_params p = exact_params();
@@ -152,12 +164,12 @@ static void test_overlap_resolved_by_ratio(void **state)
     put(a, 150, 80, 180, 800);  put(a, 150, 100, 160, 200);   /* shared cell s = (150,100,160) */
     put(b, 150, 60, 200, 500);  put(b, 150, 100, 160, 500);
     put(neg, 60, 128, 128, 1000);
-    pp[0] = a; pp[1] = b;
+    lc[0].positive = a; lc[1].positive = b;
     cyl_colortable_init(t);
     /* a box class at index 1 stays as it is */
     cyl_colortable_add_box(t, 1, 0, 255, 100, 103, 160, 163);
     p.bg_uniform_weight = 0.5;   /* finite ratios: a's at s is 0.2/bg, b's 0.5/bg */
-    assert_int_equal(cyl_colortable_learn(t, cls, pp, 2, neg, &p, work, ws, r), CYL_OK);
+    assert_int_equal(cyl_colortable_learn(t, lc, 2, neg, &p, work, ws, r), CYL_OK);
     assert_float_equal(r[0].recall_alone, 1.0, 1e-12);
     assert_float_equal(r[0].recall, 0.8, 1e-12);
     assert_float_equal(r[0].lost_to[5], 0.2, 1e-12);
@@ -167,17 +179,17 @@ static void test_overlap_resolved_by_ratio(void **state)
     assert_int_equal(cyl_colortable_mask(t, 150, 80, 180), 1u << 0);
     assert_int_equal(cyl_colortable_mask(t, 20, 100, 160), 1u << 1);   /* box class: every brightness */
     /* errors */
-    cls[1] = 0;
-    assert_int_equal(cyl_colortable_learn(t, cls, pp, 2, neg, &p, work, ws, r), CYL_ERR_ARG);
-    cls[1] = 8;
-    assert_int_equal(cyl_colortable_learn(t, cls, pp, 2, neg, &p, work, ws, r), CYL_ERR_CLASS);
-    cls[1] = 5;
-    assert_int_equal(cyl_colortable_learn(t, cls, pp, 2, neg, &p, work, ws - 1, r), CYL_ERR_NOMEM);
+    lc[1].cls = 0;
+    assert_int_equal(cyl_colortable_learn(t, lc, 2, neg, &p, work, ws, r), CYL_ERR_ARG);
+    lc[1].cls = 8;
+    assert_int_equal(cyl_colortable_learn(t, lc, 2, neg, &p, work, ws, r), CYL_ERR_CLASS);
+    lc[1].cls = 5;
+    assert_int_equal(cyl_colortable_learn(t, lc, 2, neg, &p, work, ws - 1, r), CYL_ERR_NOMEM);
     p.max_bg_fraction = 1.5;
-    assert_int_equal(cyl_colortable_learn(t, cls, pp, 2, neg, &p, work, ws, r), CYL_ERR_ARG);
+    assert_int_equal(cyl_colortable_learn(t, lc, 2, neg, &p, work, ws, r), CYL_ERR_ARG);
     p.max_bg_fraction = 0.01;
     cyl_colorhist_clear(neg);
-    assert_int_equal(cyl_colortable_learn(t, cls, pp, 2, neg, &p, work, ws, r), CYL_ERR_EMPTY);
+    assert_int_equal(cyl_colortable_learn(t, lc, 2, neg, &p, work, ws, r), CYL_ERR_EMPTY);
     free(a); free(b); free(neg); free(t); free(work);
 }
 
@@ -193,8 +205,8 @@ static void test_brightness_dependent_chroma(void **state)
     size_t cap;
     cyl_colorhist *pos = hist_new(), *neg = hist_new();
     cyl_colortable *t = malloc(sizeof *t);
-    const cyl_colorhist *pp[1];
-    unsigned cls = 0, i;
+    cyl_learn_class lc = { 0, CYL_CLASS_NONE, NULL };
+    unsigned i;
     size_t ws = cyl_learn_workspace_size(1);
     void *work = malloc(ws);
     cyl_learn_report r;
@@ -216,9 +228,9 @@ static void test_brightness_dependent_chroma(void **state)
     assert_int_equal(cyl_colorhist_add(pos, &img, NULL, mask, 64, 1), CYL_OK);
     assert_int_equal(cyl_colorhist_add(neg, &img, NULL, mask, 64, 0), CYL_OK);
     assert_int_equal(pos->total + neg->total, 64 * 64);
-    pp[0] = pos;
+    lc.positive = pos;
     cyl_colortable_init(t);
-    assert_int_equal(cyl_colortable_learn(t, &cls, pp, 1, neg, NULL, work, ws, &r), CYL_OK);
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, NULL, work, ws, &r), CYL_OK);
     assert_true(r.recall > 0.99);
     assert_true(r.bg_fraction < 0.001);
     assert_float_equal(r.grey_fraction, 0.0, 0);
@@ -233,6 +245,100 @@ static void test_brightness_dependent_chroma(void **state)
     free(buf); free(mask); free(pos); free(neg); free(t); free(work);
 }
 
+/* A weak class (hysteresis). Positives: 800 px at a, 100 at c, 100 at d; negatives: 10 at
+ * c, 200 at d, 9790 at b. Ratios a infinite, c 100, d 0.1 / 0.02 = 5. At a rate of 0.002
+ * the class keeps a and c; d (0.02 more) goes to the weak class, within 0.05. Then
+ * segmentation: d next to a joins a's blob, d alone is dropped. */
+static void test_weak_class_hysteresis(void **state)
+{
+    cyl_colorhist *pos = hist_new(), *neg = hist_new();
+    cyl_colortable *t = malloc(sizeof *t);
+    cyl_learn_class lc = { 1, 4, NULL };
+    size_t ws = cyl_learn_workspace_size(1), ms;
+    void *work = malloc(ws), *mem;
+    cyl_learn_params p = exact_params();
+    cyl_learn_report r;
+    canvas c;
+    cyl_image img;
+    uint8_t *buf;
+    size_t cap;
+    cyl_segmentation seg;
+    cyl_segment_params sp = cyl_segment_params_default();
+    unsigned k;
+    (void)state;
+    put(pos, 120, 200, 60, 800);   /* a */
+    put(pos, 120, 90, 90, 100);    /* c */
+    put(pos, 200, 160, 100, 100);  /* d */
+    put(neg, 120, 90, 90, 10);
+    put(neg, 200, 160, 100, 200);
+    put(neg, 60, 128, 128, 9790);  /* b */
+    lc.positive = pos;
+    p.min_likelihood_ratio = 4.0;
+    p.min_weak_ratio = 1.0;
+    p.max_bg_fraction = 0.002;
+    p.weak_bg_fraction = 0.05;
+    cyl_colortable_init(t);
+    cyl_colortable_set_class(t, 1, "ball", 255, 255, 0);
+    cyl_colortable_set_class(t, 4, "ball~", 128, 128, 0);
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(r.cells, 2);
+    assert_int_equal(r.weak_cells, 1);
+    assert_float_equal(r.recall, 0.9, 1e-12);
+    assert_float_equal(r.weak_recall, 0.1, 1e-12);
+    assert_float_equal(r.weak_bg_fraction, 0.02, 1e-12);
+    assert_int_equal(cyl_colortable_mask(t, 120, 200, 60), 1u << 1);
+    assert_int_equal(cyl_colortable_mask(t, 200, 160, 100), 1u << 4);
+    assert_int_equal(t->weak_of[4], 1);
+    assert_int_equal(t->weak_of[1], CYL_CLASS_NONE);
+    assert_int_equal(t->lookup, CYL_LOOKUP_YUV);
+
+    /* 40 x 20 frame: a at x 5..14 rows 5..9; d right of it (x 15..24, rows 5..9: side by side
+     * in each row) and below it (x 5..14, rows 10..12); d alone at x 30..37 rows 5..12 */
+    assert_true(canvas_alloc(&c, 40, 20));
+    canvas_fill(&c, 60, 128, 128);
+    canvas_rect(&c, 5, 5, 10, 5, 120, 200, 60);
+    canvas_rect(&c, 15, 5, 10, 5, 200, 160, 100);
+    canvas_rect(&c, 5, 10, 10, 3, 200, 160, 100);
+    canvas_rect(&c, 30, 5, 8, 8, 200, 160, 100);
+    cap = canvas_format_size(&c, CYL_FMT_YUV444P, 0);
+    buf = malloc(cap);
+    assert_true(canvas_to_format(&c, CYL_FMT_YUV444P, 0, 0, buf, cap, &img));
+    ms = cyl_segment_mem_size(1000, 1000);
+    mem = malloc(ms);
+    assert_int_equal(cyl_segmentation_init(&seg, mem, ms, 1000, 1000), CYL_OK);
+    for (k = 0; k < CYL_MAX_CLASSES; k++) sp.cls[k].merge_gap_px = -1;
+    assert_int_equal(cyl_segment(t, &img, &sp, &seg), CYL_OK);
+    assert_int_equal(seg.n_blobs, 1);
+    assert_int_equal(seg.blobs[0].cls, 1);
+    assert_int_equal(seg.blobs[0].area, 50 + 50 + 30);
+    assert_int_equal(seg.blobs[0].x0, 5); assert_int_equal(seg.blobs[0].x1, 24);
+    assert_int_equal(seg.blobs[0].y0, 5); assert_int_equal(seg.blobs[0].y1, 12);
+    assert_int_equal(seg.class_count[4], 0);
+    /* without the relation, d is a class of its own */
+    assert_int_equal(cyl_colortable_set_weak(t, 4, CYL_CLASS_NONE), CYL_OK);
+    assert_int_equal(cyl_segment(t, &img, &sp, &seg), CYL_OK);
+    assert_int_equal(seg.n_blobs, 4);   /* a; d right of it, d below it (not 4-connected to each other), d alone */
+    /* the relation's rules */
+    assert_int_equal(cyl_colortable_set_weak(t, 4, 4), CYL_ERR_ARG);
+    assert_int_equal(cyl_colortable_set_weak(t, 4, 1), CYL_OK);
+    assert_int_equal(cyl_colortable_set_weak(t, 1, 2), CYL_ERR_ARG);   /* 1 has a weak class itself */
+    assert_int_equal(cyl_colortable_set_weak(t, 2, 4), CYL_ERR_ARG);   /* 4 is weak */
+    assert_int_equal(cyl_colortable_set_weak(t, 9, 1), CYL_ERR_CLASS);
+    /* it survives a file round trip (version 2) */
+    {
+        uint8_t *fb = malloc(CYL_TABLE_FILE_MAX_SIZE);
+        cyl_colortable *u = malloc(sizeof *u);
+        size_t len;
+        assert_int_equal(cyl_colortable_save(t, fb, CYL_TABLE_FILE_MAX_SIZE, &len), CYL_OK);
+        assert_int_equal(fb[8 + 4 * 20 + 19], 2);   /* class 4's record: 1 + weak_of */
+        assert_int_equal(cyl_colortable_load(u, fb, len), CYL_OK);
+        assert_memory_equal(u, t, sizeof *t);
+        free(fb); free(u);
+    }
+    canvas_free(&c);
+    free(buf); free(mem); free(pos); free(neg); free(t); free(work);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -240,6 +346,7 @@ int main(void)
         cmocka_unit_test(test_rate_decides_hand_derived),
         cmocka_unit_test(test_overlap_resolved_by_ratio),
         cmocka_unit_test(test_brightness_dependent_chroma),
+        cmocka_unit_test(test_weak_class_hysteresis),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

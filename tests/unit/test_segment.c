@@ -407,9 +407,9 @@ static void test_bad_arguments(void **state)
 static void test_bruteforce_random(void **state)
 {
     static const cyl_pixfmt fmts[] = { CYL_FMT_YUYV, CYL_FMT_UYVY, CYL_FMT_NV12, CYL_FMT_I420, CYL_FMT_YUV444P };
-    static const uint8_t speck[4][3] = { { ORANGE }, { GREEN }, { 200, 120, 170 }, { GREY } };
+    static const uint8_t speck[5][3] = { { ORANGE }, { GREEN }, { 200, 120, 170 }, { GREY }, { 150, 200, 170 } };
     test_rng rng;
-    int iter, total_blobs = 0;
+    int iter, total_blobs = 0, weak_runs = 0;
     uint32_t max_runs = 200000, max_blobs = 20000;
     size_t ms = cyl_segment_mem_size(max_runs, max_blobs);
     void *mem = malloc(ms);
@@ -432,6 +432,10 @@ static void test_bruteforce_random(void **state)
         cyl_colortable_refresh(&table);
         assert_int_equal(table.lookup, CYL_LOOKUP_UV_Y | CYL_LOOKUP_YUV);
     }
+    /* and a weak class: 3 is the weak evidence of 1 (green); its colour is the third speck's */
+    cyl_colortable_set_class(&table, 3, "green~", 0, 128, 0);
+    cyl_colortable_add_box(&table, 3, 100, 255, 190, 210, 160, 180);
+    assert_int_equal(cyl_colortable_set_weak(&table, 3, 1), CYL_OK);
     assert_int_equal(cyl_segmentation_init(&seg, mem, ms, max_runs, max_blobs), CYL_OK);
     test_rng_seed(&rng, 20261122);
     for (iter = 0; iter < 3000; iter++) {
@@ -447,11 +451,12 @@ static void test_bruteforce_random(void **state)
         assert_true(canvas_alloc(&c, w, h));
         canvas_fill(&c, GREY);
         for (i = 0; i < nrect; i++) {
-            const uint8_t *col = speck[test_rng_int(&rng, 0, 2)];
+            const int pick = (int)test_rng_int(&rng, 0, 3);
+            const uint8_t *col = speck[pick == 3 ? 4 : pick];
             canvas_rect(&c, (int32_t)test_rng_int(&rng, -5, (int64_t)w), (int32_t)test_rng_int(&rng, -5, (int64_t)h),
                         (int32_t)test_rng_int(&rng, 1, 30), (int32_t)test_rng_int(&rng, 1, 30), col[0], col[1], col[2]);
         }
-        canvas_speckle(&c, &rng, test_rng_uniform(&rng) * 0.3, speck, 4);
+        canvas_speckle(&c, &rng, test_rng_uniform(&rng) * 0.3, speck, 5);
         if (test_rng_int(&rng, 0, 1)) canvas_noise(&c, &rng, 4.0, 6.0);
         stride = test_rng_int(&rng, 0, 1) ? 0 : (size_t)(fmt == CYL_FMT_YUYV || fmt == CYL_FMT_UYVY ? 4 * ((w + 1) / 2) : w) + (size_t)test_rng_int(&rng, 1, 13);
         cap = canvas_format_size(&c, fmt, stride);
@@ -487,7 +492,9 @@ static void test_bruteforce_random(void **state)
             assert_true(fabs(b->mxy_px2 - r->mxy) < 1e-6);
             for (ri = b->first_run; ri != CYL_NONE; ri = seg.runs[ri].next) {
                 assert_int_equal(seg.runs[ri].blob, (uint32_t)i);
-                assert_int_equal(seg.runs[ri].cls, b->cls);
+                /* runs keep their own class: the blob's, or its weak class's */
+                assert_true(seg.runs[ri].cls == b->cls || table.weak_of[seg.runs[ri].cls] == b->cls);
+                weak_runs += seg.runs[ri].cls != b->cls;
                 area += seg.runs[ri].width;
                 cnt++;
             }
@@ -499,6 +506,7 @@ static void test_bruteforce_random(void **state)
         canvas_free(&c);
     }
     assert_true(total_blobs > 3000); /* the frames were not trivially empty */
+    assert_true(weak_runs > 500);    /* and weak runs joined blobs */
     free(mem);
     free(ref);
 }

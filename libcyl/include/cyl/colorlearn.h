@@ -21,8 +21,14 @@
  *     background pixels it would claim stay within max_bg_fraction (the
  *     false-positive rate, Neyman-Pearson) and never a cell with L below
  *     min_likelihood_ratio.
- *  4. Where two learned classes claim a cell, the one with the larger L keeps
- *     it; the report says how much each class lost to each other.
+ *  4. Optionally, a weak class: the cells with L between a second, lower
+ *     threshold (chosen the same way from weak_bg_fraction) and the first go
+ *     to a second table class marked as the first one's weak evidence
+ *     (cyl_colortable_set_weak): segmentation keeps such pixels only where
+ *     they touch the class's own (hysteresis, cyl/segment.h).
+ *  5. Where two learned classes claim a cell, the one with the larger L keeps
+ *     it (a class's own cells before any weak ones); the report says how much
+ *     each class lost to each other.
  *
  * The result is written into the table's yuv cells, so segmentation stays a
  * direct lookup. Nothing here allocates: histograms and the workspace are the
@@ -55,6 +61,15 @@ static inline uint32_t cyl_yuv_cell(uint8_t Y, uint8_t U, uint8_t V)
            (uint32_t)(V >> CYL_YUV_CSHIFT);
 }
 
+/* Like cyl_colorhist_add(), with each pixel's colour as it would be under an exposure
+ * scaled by gain (> 0): Y' = gain Y, U' = 128 + gain (U - 128), V' likewise, rounded and
+ * clipped to 0..255. Adding a training image at several gains teaches a class the colours it
+ * takes when the light or the exposure changes (photometric augmentation). CYL_ERR_ARG for a
+ * gain outside (0, 16]. */
+cyl_status cyl_colorhist_add_scaled(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
+                                    const uint8_t *mask, size_t mask_stride, uint8_t mask_value,
+                                    double gain);
+
 /* Empty histogram. */
 void cyl_colorhist_clear(cyl_colorhist *h);
 
@@ -76,6 +91,10 @@ typedef struct cyl_learn_params {
     double min_likelihood_ratio; /* a cell with a smaller ratio is never claimed (default 4) */
     double min_positive_count;   /* ... nor one whose smoothed count of class pixels is below this,
                                     pixels (default 0.5: stray single pixels claim nothing) */
+    double weak_bg_fraction;     /* for classes with a weak class: the share of the background density
+                                    the class and its weak class may claim together, >= max_bg_fraction
+                                    (default 0.02) */
+    double min_weak_ratio;       /* a weak cell's ratio is at least this (default 1) */
 } cyl_learn_params;
 
 /* The defaults above. */
@@ -89,25 +108,35 @@ typedef struct cyl_learn_report {
     double bg_fraction;           /* share of the negative pixels in the cells it kept */
     double lr_threshold;          /* likelihood-ratio threshold the false-positive rate chose */
     uint32_t cells;               /* cells kept */
+    double weak_recall;           /* share of its positive pixels in the cells its weak class kept */
+    double weak_bg_fraction;      /* share of the negative pixels in them */
+    double weak_lr_threshold;     /* the weak class's threshold (0 without a weak class) */
+    uint32_t weak_cells;          /* cells its weak class kept */
     double grey_fraction;         /* share of its kept cells whose chroma lies within 8 levels of grey
                                      (U and V both within 128 +- 8) */
     double lost_to[CYL_MAX_CLASSES]; /* share of its positive pixels in cells claimed by both it and
                                         class j that class j kept (larger likelihood ratio) */
 } cyl_learn_report;
 
+/* One class to learn. */
+typedef struct cyl_learn_class {
+    unsigned cls;                    /* its table index */
+    unsigned weak_cls;               /* table index for its weak evidence, or CYL_CLASS_NONE */
+    const cyl_colorhist *positive;   /* its training pixels */
+} cyl_learn_class;
+
 /* Bytes of workspace cyl_colortable_learn() needs for n classes. */
 size_t cyl_learn_workspace_size(unsigned n);
 
-/* Learn n classes at once: class cls[i] of t from the histogram positive[i],
- * against the background histogram negative (shared by all). Each learned
- * class's previous colours are replaced (cyl_colortable_clear_class) by its
- * learned cells; other classes are untouched. reports (n entries) may be NULL.
+/* Learn n classes at once against the background histogram negative (shared by
+ * all). Each learned class's (and weak class's) previous colours are replaced
+ * (cyl_colortable_clear_class) by its learned cells and the weak relation is
+ * set; other classes are untouched. reports (n entries) may be NULL.
  * work: cyl_learn_workspace_size(n) bytes aligned for float.
- * Errors: CYL_ERR_ARG (bad parameter, repeated class), CYL_ERR_CLASS,
+ * Errors: CYL_ERR_ARG (bad parameter, a table index used twice), CYL_ERR_CLASS,
  * CYL_ERR_NOMEM (workspace), CYL_ERR_EMPTY (a class or the background has no
  * pixels, or a class would claim no cell; the table is then unchanged). */
-cyl_status cyl_colortable_learn(cyl_colortable *t, const unsigned *cls,
-                                const cyl_colorhist *const *positive, unsigned n,
+cyl_status cyl_colortable_learn(cyl_colortable *t, const cyl_learn_class *classes, unsigned n,
                                 const cyl_colorhist *negative, const cyl_learn_params *params,
                                 void *work, size_t work_size, cyl_learn_report *reports);
 

@@ -57,6 +57,10 @@ typedef struct cyl_colortable {
                                                          reject a pixel (segmentation skips the others);
                                                          kept by every function here; after writing uv, y
                                                          or yuv directly, call cyl_colortable_refresh() */
+    uint8_t weak_of[CYL_MAX_CLASSES];                 /* CYL_CLASS_NONE, or the class whose weak evidence
+                                                         this class is: segmentation joins its pixels to
+                                                         that class's blobs where they touch and drops
+                                                         them elsewhere (hysteresis; see cyl/segment.h) */
     cyl_mask live;                                    /* classes that can match some pixel; read only when
                                                          lookup is CYL_LOOKUP_YUV alone (set by
                                                          cyl_colortable_refresh()) */
@@ -77,6 +81,11 @@ cyl_status cyl_colortable_set_class(cyl_colortable *t, unsigned cls, const char 
 
 /* Index of the class with this exact name, or -1. */
 int cyl_colortable_find_class(const cyl_colortable *t, const char *name);
+
+/* Make class weak the weak evidence of class strong (CYL_CLASS_NONE: an ordinary class
+ * again). A weak class cannot itself have a weak class, nor be its own. CYL_ERR_CLASS,
+ * CYL_ERR_ARG. */
+cyl_status cyl_colortable_set_weak(cyl_colortable *t, unsigned weak, unsigned strong);
 
 /* Remove class cls's colours: its bits in uv and y are cleared and its yuv bits
  * set again, so that it matches nothing and boxes can be added afresh (its name
@@ -153,7 +162,7 @@ cyl_status cyl_colortable_train(cyl_colortable *t, unsigned cls, const cyl_image
  *   4          2      format version (1)
  *   6          1      number of classes (8)
  *   7          1      reserved (0)
- *   8          160    8 x { name[16] NUL-terminated, rgb[3], reserved[1] }
+ *   8          160    8 x { name[16] NUL-terminated, rgb[3], reserved[1] (0) }
  *   168        256    y[256] class masks
  *   424        65536  uv[256][256] class masks, U-major
  *   65960      4      CRC-32 (IEEE 802.3, as zlib's crc32) of bytes 0..65959
@@ -161,7 +170,8 @@ cyl_status cyl_colortable_train(cyl_colortable *t, unsigned cls, const cyl_image
 #define CYL_TABLE_FILE_VERSION 1u
 #define CYL_TABLE_FILE_SIZE 65964u
 
-/* Version 2 (CYL_TABLE_FILE_SIZE_V2 bytes) is version 1 with the 3-D table
+/* Version 2 (CYL_TABLE_FILE_SIZE_V2 bytes) is version 1 with each class record's
+ * last byte holding 1 + weak_of (0: an ordinary class) and the 3-D table
  * inserted before the CRC:
  *   65960      131072 yuv[32][64][64] class masks, Y-major, then U, then V
  *   197032     4      CRC-32 of bytes 0..197031
@@ -170,7 +180,7 @@ cyl_status cyl_colortable_train(cyl_colortable *t, unsigned cls, const cyl_image
 #define CYL_TABLE_FILE_SIZE_V2 197036u
 #define CYL_TABLE_FILE_MAX_SIZE CYL_TABLE_FILE_SIZE_V2   /* the largest file any version has */
 
-/* Serialise into buf: version 1 when no class has a 3-D part (so older readers
+/* Serialise into buf: version 1 when no class has a 3-D part or weak class (so older readers
  * still load it), version 2 otherwise. cap must be at least the size written
  * (CYL_TABLE_FILE_MAX_SIZE always suffices); *len receives the byte count. */
 cyl_status cyl_colortable_save(const cyl_colortable *t, uint8_t *buf, size_t cap, size_t *len);

@@ -7,6 +7,13 @@
  * over runs of the same class into blobs, per-blob statistics, merging of
  * nearby blobs of the same class, and sorting (by class, then area).
  *
+ * Weak classes (hysteresis, cyl_colortable_set_weak): the runs of a class W
+ * that is the weak evidence of class S connect with S's runs (4-connected,
+ * including side by side in a row) and with each other; a component keeps
+ * only if it holds at least one run of S, and its blob has class S. Learned
+ * tables use this for colours that are likely but not certain (the pale top
+ * of a lit ball next to its saturated side). Runs keep their own class.
+ *
  * Sampling: with a region of interest and steps, the frame is read on the
  * grid of sample points (roi.x + i * x_step, roi.y + j * y_step). Runs and
  * blobs are expressed in full-image pixel coordinates of those samples; areas
