@@ -18,6 +18,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <sys/stat.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 using namespace cylfe;
 
@@ -36,7 +40,7 @@ void usage(FILE *f)
         "  -o, --output PATH       raw log to write (default build/drive.cylraw)\n"
         "  -n, --frames N          number of frames (default 1000)\n"
         "  -s, --seed N            random seed: noise, odometry, exposure (default 7)\n"
-        "  -S, --scene NAME|PATH   'default' (built in), 'empty', or a scene file (YAML/JSON,\n"
+        "  -S, --scene NAME|PATH   'default' or 'hard' (built in), 'empty', or a scene file (YAML/JSON,\n"
         "                          docs/synthetic.md) (default: default)\n"
         "      --samples N         override the scene's supersampling (N x N per pixel, 1..4)\n"
         "      --calib-error       render with a camera whose calibration differs from the scene's\n"
@@ -46,6 +50,10 @@ void usage(FILE *f)
         "      --write-table PATH  train a colour table for the scene's colours on rendered\n"
         "                          frames (libcyl CYLT file) and exit\n"
         "      --write-camera PATH write the scene camera as a calibration YAML and exit\n"
+        "      --labels DIR        also write every frame as DIR/images/frame_NNNNNN.png with its\n"
+        "                          landmarks' visible boxes as YOLO labels (DIR/labels/, class id =\n"
+        "                          colour class; boxes of >= 12 visible px) and DIR/truth.csv\n"
+        "                          (frame, landmark id, class, box, px count); DIR must exist\n"
         "  -q, --quiet             no progress bar\n"
         "  -h, --help              this help\n"
         "      --version           the version\n"
@@ -67,12 +75,50 @@ bool parse_u64(const char *s, uint64_t &v)
     return true;
 }
 
+// One frame as an image file with its landmarks' visible boxes (YOLO) and truth rows.
+void write_labelled_frame(const std::string &dir, uint64_t k, const cyl_image &img, const synth::Scene &scene,
+                          const std::vector<int32_t> &label, std::string &truth_csv)
+{
+    char stem[32];
+    std::snprintf(stem, sizeof stem, "frame_%06llu", (unsigned long long)k);
+    const int W = (int)img.width, H = (int)img.height;
+    cv::Mat yuyv(H, W, CV_8UC2, const_cast<uint8_t *>(img.plane[0]), img.stride[0]), bgr;
+    cv::cvtColor(yuyv, bgr, cv::COLOR_YUV2BGR_YUYV);
+    const std::string png = dir + "/images/" + stem + ".png";
+    if (!cv::imwrite(png, bgr)) throw Error(png + ": cannot write image");
+    struct Bx { int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1; long n = 0; };
+    std::vector<Bx> bx(scene.cylinders.size());
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            int32_t l = label[(size_t)y * W + x];
+            if (l < 0) continue;
+            Bx &b = bx[(size_t)l];
+            b.x0 = std::min(b.x0, x); b.x1 = std::max(b.x1, x);
+            b.y0 = std::min(b.y0, y); b.y1 = std::max(b.y1, y);
+            b.n++;
+        }
+    std::string yolo;
+    char line[160];
+    for (size_t i = 0; i < bx.size(); i++) {
+        const Bx &b = bx[i];
+        const synth::Cylinder &c = scene.cylinders[i];
+        if (b.n < 12 || c.cls < 0) continue;
+        std::snprintf(line, sizeof line, "%d %.6f %.6f %.6f %.6f\n", c.cls, (b.x0 + b.x1 + 1) / 2.0 / W,
+                      (b.y0 + b.y1 + 1) / 2.0 / H, (b.x1 - b.x0 + 1.0) / W, (b.y1 - b.y0 + 1.0) / H);
+        yolo += line;
+        std::snprintf(line, sizeof line, "%llu,%u,%d,%d,%d,%d,%d,%ld\n", (unsigned long long)k, c.id, c.cls, b.x0, b.y0,
+                      b.x1 + 1, b.y1 + 1, b.n);
+        truth_csv += line;
+    }
+    cylfe::write_file_atomic(dir + "/labels/" + stem + ".txt", yolo);
+}
+
 } // namespace
 
 int main(int argc, char **argv)
 {
     if (cylfe::print_version_if_asked(argc, argv, "cyl-render")) return 0;
-    std::string out = "build/drive.cylraw", scene_name = "default", write_scene, write_table, write_camera;
+    std::string out = "build/drive.cylraw", scene_name = "default", write_scene, write_table, write_camera, labels_dir;
     uint64_t frames = 1000, seed = 7, samples = 0;
     bool quiet = false, calib_error = false;
     for (int i = 1; i < argc; i++) {
@@ -90,6 +136,7 @@ int main(int argc, char **argv)
         else if (a == "--write-scene") write_scene = val("--write-scene");
         else if (a == "--write-table") write_table = val("--write-table");
         else if (a == "--write-camera") write_camera = val("--write-camera");
+        else if (a == "--labels") labels_dir = val("--labels");
         else if (a == "-q" || a == "--quiet") quiet = true;
         else if (a == "--calib-error") calib_error = true;
         else if (a == "-n" || a == "--frames" || a == "-s" || a == "--seed" || a == "--samples") {
@@ -159,6 +206,17 @@ int main(int argc, char **argv)
             scene.camera = t;
         }
         synth::SyntheticSource src(scene, (uint32_t)frames, seed);
+        std::string truth_csv;
+        if (!labels_dir.empty()) {
+            struct stat st;
+            if (::stat(labels_dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
+                throw Error(labels_dir + ": --labels needs an existing folder");
+            for (const char *sub : {"/images", "/labels"})
+                if (mkdir((labels_dir + sub).c_str(), 0777) != 0 && errno != EEXIST)
+                    throw Error(labels_dir + sub + ": cannot create folder: " + std::strerror(errno));
+            src.set_labels(true);
+            truth_csv = "frame,landmark_id,class,x0_px,y0_px,x1_px,y1_px,visible_px\n";
+        }
         RawLogWriter w(out, src.info());
         SourceEvent ev;
         auto t0 = std::chrono::steady_clock::now();
@@ -166,7 +224,11 @@ int main(int argc, char **argv)
         cylfe::Progress progress(!quiet, "rendering", "frames");
         while (!g_stop && src.next(ev)) {
             switch (ev.kind) {
-            case RecordType::Frame: w.frame(ev.header.seq, ev.header.t_ns, ev.data, ev.header.size); nframes++; break;
+            case RecordType::Frame:
+                w.frame(ev.header.seq, ev.header.t_ns, ev.data, ev.header.size);
+                if (!labels_dir.empty()) write_labelled_frame(labels_dir, nframes, ev.image, scene, src.labels(), truth_csv);
+                nframes++;
+                break;
             case RecordType::Odometry: w.odometry(ev.header.seq, ev.header.t_ns, ev.odometry); break;
             case RecordType::TruthPose: w.truth_pose(ev.header.seq, ev.header.t_ns, ev.truth_pose); break;
             case RecordType::TruthLandmark: w.truth_landmark(ev.header.t_ns, ev.truth_landmark); break;
@@ -187,6 +249,7 @@ int main(int argc, char **argv)
             return kExitInterrupted;
         }
         w.close();
+        if (!labels_dir.empty()) cylfe::write_file_atomic(labels_dir + "/truth.csv", truth_csv);
         double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         std::fprintf(stderr, "cyl-render: wrote %s: %llu frames %ux%u YUYV, %llu records, %.1f s (%.1f ms/frame)\n",
                      out.c_str(), (unsigned long long)nframes, src.info().width, src.info().height,

@@ -58,6 +58,8 @@ struct FloorPatch {                // flat coloured rectangle lying on the floor
     int32_t cls = -1;
     double x_m = 0, y_m = 0, yaw_rad = 0, size_x_m = 0.5, size_y_m = 0.5;
     Yuv colour;
+    double shadow = 0.0;           // > 0: not a coloured patch but a cast shadow, darkening the floor
+                                   // under it by this fraction (0..1) and keeping its colour
 };
 
 struct CameraModel {
@@ -94,6 +96,9 @@ struct Imaging {
     double ambient = 0.70;         // shading = ambient + diffuse * max(0, n . l)
     double diffuse = 0.40;
     double light_az_rad = 0.7, light_el_rad = 0.9;  // direction towards the (distant) light
+    double illum_gradient_per_m = 0.0;  // illumination across the room: shading * (1 + g * x_world)
+    double wb_drift = 0.0;         // white-balance drift over the drive: U += A sin(2 pi t / T),
+    double wb_period_s = 60.0;     // V -= 0.7 A sin(2 pi t / T + 0.5), in U/V levels (A = wb_drift)
 };
 
 struct Room {
@@ -151,11 +156,15 @@ struct Scene {
 Scene default_scene();
 // A static, empty room with no landmarks (experiments add their own objects).
 Scene empty_scene();
+// The default scene made hard for colour learning: a wooden floor and an olive wall in hues near
+// the landmarks', dull orange, dull green, red and yellow clutter, an illumination gradient across
+// the room, cast shadows on the floor, and exposure and white-balance drift over the drive.
+Scene hard_scene();
 // Read / write a scene file (YAML or JSON through cv::FileStorage; docs/synthetic.md). Missing
 // fields keep the defaults of an empty scene. Throws cylfe::Error naming the file and field.
 Scene load_scene(const std::string &path);
 void save_scene(const std::string &path, const Scene &s);
-// "default" -> default_scene(), "empty" -> empty_scene(), otherwise load_scene(path).
+// "default", "empty", "hard" -> the built-in scenes, otherwise load_scene(path).
 Scene scene_by_name(const std::string &name_or_path);
 
 // A camera whose intrinsics and mount differ from c by an error drawn once from the sigmas
@@ -190,6 +199,9 @@ struct CleanFrame {
     uint32_t width = 0, height = 0;
     std::vector<float> y, u, v;
     std::vector<float> scratch;  // the blur's workspace: reusing a CleanFrame reuses all its memory
+    bool want_labels = false;    // fill `label`:
+    std::vector<int32_t> label;  // per pixel, the index in Scene::cylinders of the landmark that at
+                                 // least half of the pixel's samples hit, else -1
 };
 
 class Renderer {
@@ -200,7 +212,8 @@ public:
     // Change the camera; the ray map is rebuilt when intrinsics or image size changed.
     void set_camera(const CameraModel &c);
     // Ray casting with supersampling, shading and optical blur (no noise).
-    void render_clean(const Pose2 &robot, double gain, CleanFrame &out) const;
+    // t_s: the frame's time, for the white-balance drift (Imaging::wb_drift).
+    void render_clean(const Pose2 &robot, double gain, CleanFrame &out, double t_s = 0.0) const;
     // Sensor noise (seeded), 4:2:2 chroma subsampling, quantisation into YUYV bytes
     // (width * 2 bytes per line).
     void finish_yuyv(const CleanFrame &clean, uint64_t noise_seed, std::vector<uint8_t> &yuyv) const;
@@ -259,6 +272,9 @@ public:
     bool next(SourceEvent &ev) override;
     double progress() const override;
     const Renderer &renderer() const { return renderer_; }
+    // Per-pixel landmark labels of the frame just emitted (CleanFrame::label); off by default.
+    void set_labels(bool on) { clean_.want_labels = on; }
+    const std::vector<int32_t> &labels() const { return clean_.label; }
 
 private:
     Scene scene_;

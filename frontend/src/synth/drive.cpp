@@ -199,7 +199,7 @@ bool SyntheticSource::next(SourceEvent &ev)
     ev.header.t_ns = st.t_ns;
     if (phase_ == 0) {
         double gain = renderer_.frame_gain(seed_, st.seq, st.t_ns * 1e-9);
-        renderer_.render_clean(st.truth, gain, clean_);
+        renderer_.render_clean(st.truth, gain, clean_, st.t_ns * 1e-9);
         renderer_.finish_yuyv(clean_, mix_seed(seed_, st.seq, 0x5EED), frame_);
         ev.kind = RecordType::Frame;
         ev.header.type = ev.kind;

@@ -301,7 +301,7 @@ SBox screen_box(const CameraModel &cam, const CameraPose &cp, const std::vector<
 
 } // namespace
 
-void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out) const
+void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out, double t_s) const
 {
     const Scene &s = scene_;
     const CameraModel &cam = s.camera;
@@ -344,6 +344,9 @@ void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out) co
     out.y.assign((size_t)W * H, 0.f);
     out.u.assign((size_t)W * H, 0.f);
     out.v.assign((size_t)W * H, 0.f);
+    if (out.want_labels) out.label.assign((size_t)W * H, -1);
+    const double wb_u = im.wb_drift * std::sin(2 * kPi * t_s / im.wb_period_s);
+    const double wb_v = -0.7 * im.wb_drift * std::sin(2 * kPi * t_s / im.wb_period_s + 0.5);
 
     const Room &room = s.room;
     const double floor_shade = im.ambient + im.diffuse * std::max(0.0, L[2]);
@@ -358,6 +361,8 @@ void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out) co
                 if ((int)px >= o->b.x0 && (int)px <= o->b.x1) px_objs.push_back(o);
             const float *rays = &ray_[(((size_t)py * W + px) * nn) * 2];
             double acc_y = 0, acc_u = 0, acc_v = 0;
+            int32_t lab = -1;
+            uint32_t lab_n = 0;
             for (uint32_t k = 0; k < nn; k++) {
                 double xn = rays[2 * k], yn = rays[2 * k + 1];
                 double D[3] = {xn * cp.r[0] + yn * cp.d[0] + cp.f[0], xn * cp.r[1] + yn * cp.d[1] + cp.f[1],
@@ -437,6 +442,10 @@ void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out) co
                 if (hit_obj == 0) {
                     col = s.cylinders[ho->idx].colour;
                     shade = im.ambient + im.diffuse * std::max(0.0, dot3(h.n, L));
+                    if (out.want_labels && s.cylinders[ho->idx].landmark) {
+                        if (lab == (int32_t)ho->idx) lab_n++;
+                        else if (lab_n == 0) { lab = (int32_t)ho->idx; lab_n = 1; }
+                    }
                 } else if (hit_obj == 1) {
                     col = s.boxes[ho->idx].colour;
                     shade = im.ambient + im.diffuse * std::max(0.0, dot3(h.n, L));
@@ -445,13 +454,17 @@ void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out) co
                     col = room.floor;
                     int tile = ((int)std::floor(X / 0.3) + (int)std::floor(Y / 0.3)) & 1;
                     col.y += tile ? room.floor_texture : -room.floor_texture;
+                    double shadow = 0.0;
                     for (size_t pi = 0; pi < s.patches.size(); pi++) {
                         const FloorPatch &fp = s.patches[pi];
                         double ca = pat_c[pi], sa = pat_s[pi];
                         double lx = ca * (X - fp.x_m) + sa * (Y - fp.y_m), ly = -sa * (X - fp.x_m) + ca * (Y - fp.y_m);
-                        if (std::fabs(lx) <= fp.size_x_m / 2 && std::fabs(ly) <= fp.size_y_m / 2) col = fp.colour;
+                        if (std::fabs(lx) <= fp.size_x_m / 2 && std::fabs(ly) <= fp.size_y_m / 2) {
+                            if (fp.shadow > 0) shadow = std::max(shadow, fp.shadow);
+                            else col = fp.colour;
+                        }
                     }
-                    shade = floor_shade;
+                    shade = floor_shade * (1.0 - shadow);
                 } else if (bg == 3) {
                     col = room.ceiling;
                     shade = im.ambient + im.diffuse * 0.3;
@@ -460,6 +473,8 @@ void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out) co
                     double nrm[3] = {bg == 1 ? (D[0] > 0 ? -1.0 : 1.0) : 0.0, bg == 2 ? (D[1] > 0 ? -1.0 : 1.0) : 0.0, 0};
                     shade = im.ambient + im.diffuse * (0.35 + 0.65 * std::max(0.0, dot3(nrm, L)));
                 }
+                if (im.illum_gradient_per_m != 0.0)
+                    shade *= std::max(0.2, 1.0 + im.illum_gradient_per_m * (cp.c[0] + h.t * D[0]));
                 double g = shade * gain;
                 acc_y += col.y * g;
                 acc_u += (col.u - 128.0) * g;
@@ -467,8 +482,9 @@ void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out) co
             }
             size_t o = (size_t)py * W + px;
             out.y[o] = (float)(acc_y / nn);
-            out.u[o] = (float)(128.0 + acc_u / nn);
-            out.v[o] = (float)(128.0 + acc_v / nn);
+            out.u[o] = (float)(128.0 + acc_u / nn + wb_u);
+            out.v[o] = (float)(128.0 + acc_v / nn + wb_v);
+            if (out.want_labels && 2 * lab_n >= nn) out.label[o] = lab;
         }
     }
     // Optical blur (all planes) and the chroma bandwidth limit (horizontal, chroma only).

@@ -275,6 +275,9 @@ Scene load_scene(const std::string &path)
         r.num(n, "illum_amplitude", im.illum_amplitude); r.num(n, "illum_period_s", im.illum_period_s);
         r.num(n, "ambient", im.ambient); r.num(n, "diffuse", im.diffuse);
         r.num(n, "light_az_deg", im.light_az_rad, kDeg); r.num(n, "light_el_deg", im.light_el_rad, kDeg);
+        r.num(n, "illum_gradient_per_m", im.illum_gradient_per_m);
+        r.num(n, "wb_drift", im.wb_drift); r.num(n, "wb_period_s", im.wb_period_s);
+        if (!(im.wb_period_s > 0)) throw Error(path + ": imaging.wb_period_s must be > 0");
     }
     n = r.sub(root, "trajectory");
     if (!n.empty()) {
@@ -330,6 +333,8 @@ Scene load_scene(const std::string &path)
         r.num(it, "x_m", p.x_m); r.num(it, "y_m", p.y_m); r.num(it, "yaw_deg", p.yaw_rad, kDeg);
         r.num(it, "size_x_m", p.size_x_m); r.num(it, "size_y_m", p.size_y_m);
         r.yuv(it, "colour", p.colour);
+        r.num(it, "shadow", p.shadow);
+        if (!(p.shadow >= 0 && p.shadow <= 1)) throw Error(path + ": patches[" + std::to_string(i_patches - 1) + "].shadow must be in [0, 1]");
         s.patches.push_back(p);
     }
     r.check_unknown();
@@ -365,7 +370,9 @@ void save_scene(const std::string &path, const Scene &s)
        << "chroma_blur_px" << im.chroma_blur_px << "noise_y" << im.noise_y << "noise_c" << im.noise_c
        << "exposure" << im.exposure << "exposure_jitter" << im.exposure_jitter << "illum_amplitude" << im.illum_amplitude
        << "illum_period_s" << im.illum_period_s << "ambient" << im.ambient << "diffuse" << im.diffuse
-       << "light_az_deg" << im.light_az_rad / kDeg << "light_el_deg" << im.light_el_rad / kDeg << "}";
+       << "light_az_deg" << im.light_az_rad / kDeg << "light_el_deg" << im.light_el_rad / kDeg
+       << "illum_gradient_per_m" << im.illum_gradient_per_m << "wb_drift" << im.wb_drift << "wb_period_s" << im.wb_period_s
+       << "}";
     const TrajectoryParams &t = s.trajectory;
     fs << "trajectory" << "{" << "type" << t.type << "centre_x_m" << t.centre_x_m << "centre_y_m" << t.centre_y_m
        << "a_m" << t.a_m << "b_m" << t.b_m << "speed_mps" << t.speed_mps << "fps" << t.fps << "phase0" << t.phase0 << "}";
@@ -391,7 +398,7 @@ void save_scene(const std::string &path, const Scene &s)
     fs << "patches" << "[";
     for (const FloorPatch &p : s.patches) {
         fs << "{" << "class" << cname(p.cls) << "x_m" << p.x_m << "y_m" << p.y_m << "yaw_deg" << p.yaw_rad / kDeg
-           << "size_x_m" << p.size_x_m << "size_y_m" << p.size_y_m;
+           << "size_x_m" << p.size_x_m << "size_y_m" << p.size_y_m << "shadow" << p.shadow;
         yuv("colour", p.colour);
         fs << "}";
     }
@@ -399,10 +406,50 @@ void save_scene(const std::string &path, const Scene &s)
     fs.release();
 }
 
+Scene hard_scene()
+{
+    Scene s = default_scene();
+    s.name = "hard";
+    s.room.floor = {120, 105, 152};   // wood: the landmarks' orange hue at 40% of its saturation
+    s.room.floor_texture = 12.0;
+    s.room.wall = {150, 114, 118};    // olive: the green landmarks' hue, half saturated
+    s.imaging.illum_gradient_per_m = 0.07;
+    s.imaging.illum_amplitude = 0.2;
+    s.imaging.exposure_jitter = 0.05;
+    s.imaging.wb_drift = 6.0;
+    s.imaging.wb_period_s = 50.0;
+    struct C { double x, y, sx, sy, sz, yaw_deg; Yuv col; };
+    const C clutter[] = {
+        {-1.2, 3.1, 0.5, 0.3, 0.45, 15, {120, 92, 168}},    // dull orange crate
+        {2.6, 2.9, 0.4, 0.4, 0.35, -20, {104, 114, 100}},   // dull green bin
+        {-3.8, -1.2, 0.3, 0.5, 0.5, 40, {86, 104, 206}},    // red-orange box
+        {3.9, 2.2, 0.35, 0.35, 0.3, 0, {178, 62, 148}},     // yellow box
+        {-0.6, -3.0, 0.6, 0.3, 0.25, 5, {130, 100, 160}},   // tan cardboard
+    };
+    for (const C &c : clutter) {
+        Box b;
+        b.cls = -1;
+        b.x_m = c.x; b.y_m = c.y; b.yaw_rad = c.yaw_deg * kDeg;
+        b.size_x_m = c.sx; b.size_y_m = c.sy; b.size_z_m = c.sz;
+        b.colour = c.col;
+        s.boxes.push_back(b);
+    }
+    // cast shadows on the floor (darkening, colour kept)
+    const double sh[][4] = {{0.0, 2.2, 1.4, 0.45}, {1.5, -2.0, 1.0, 0.5}, {-2.4, -2.3, 1.2, 0.4}, {3.2, 0.3, 0.8, 0.5}};
+    for (const auto &x : sh) {
+        FloorPatch p;
+        p.x_m = x[0]; p.y_m = x[1]; p.size_x_m = x[2]; p.size_y_m = 0.8; p.yaw_rad = 25 * kDeg;
+        p.shadow = x[3];
+        s.patches.push_back(p);
+    }
+    return s;
+}
+
 Scene scene_by_name(const std::string &n)
 {
     if (n == "default") return default_scene();
     if (n == "empty") return empty_scene();
+    if (n == "hard") return hard_scene();
     return load_scene(n);
 }
 
