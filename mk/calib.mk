@@ -1,7 +1,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Calibration tools (docs/calibration.md):
 #   build/cyl-calibrate   intrinsics (Ceres, full covariance) and the robot mount's extrinsics
-#   build/cyl-train       colour-table training (command line and interactive window)
+#   build/cyl-train       colour-table training (command line and interactive window; learn
+#                         from labelled images)
+#   build/cyl-score       a colour table against labelled held-out images
 #   make calib-check      our calibration vs cv::calibrateCamera on OpenCV's sample images, the
 #                         Monte Carlo of the sigmas; last line a JSON object
 # Library sources in frontend/src/calib/ -> build/calib/libcalibtools.a (not part of libfrontend.a).
@@ -33,8 +35,21 @@ $(BUILD)/cyl-calibrate: frontend/tools/cyl_calibrate.cpp $(CALIB_DEPS)
 $(BUILD)/cyl-train: frontend/tools/cyl_train.cpp $(CALIB_DEPS)
 	$(CXX) $(CALIB_CXXFLAGS) $< -o $@.tmp $(CALIB_LIBS) && mv $@.tmp $@
 
-calib-tools: $(BUILD)/cyl-calibrate $(BUILD)/cyl-train
+$(BUILD)/cyl-score: frontend/tools/cyl_score.cpp $(CALIB_DEPS)
+	$(CXX) $(CALIB_CXXFLAGS) $< -o $@.tmp $(CALIB_LIBS) && mv $@.tmp $@
+
+calib-tools: $(BUILD)/cyl-calibrate $(BUILD)/cyl-train $(BUILD)/cyl-score
 .PHONY: calib-tools
+
+# ---- colour learning on real labelled images (docs/colour-learning.md) -------------------------
+# make realeval: the full benchmark on the real image sets outside the repository (SHARED, default
+# ../shared); make test runs its small committed form (tests/fixtures/real).
+SHARED ?= ../shared
+realeval: $(BUILD)/cyl-train $(BUILD)/cyl-score
+	@python3 scripts/realeval.py --shared $(SHARED) --build $(BUILD)
+.PHONY: realeval
+TEST_EXTRA += $(BUILD)/cyl-score $(BUILD)/cyl-train $(BUILD)/cyl
+TEST_EXTRA_BINS += tests/frontend/test_colour_learning.sh:$(BUILD)
 
 # ---- tests and the check ------------------------------------------------------------------------
 CALIB_TESTFLAGS = $(CALIB_CXXFLAGS) -Itests/calib -DCALIB_FIXTURES=\"$(CURDIR)/tests/fixtures/opencv_left\"

@@ -5,6 +5,13 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include "cylfe/keys.hpp"
 
 namespace cylfe {
 
@@ -72,7 +79,59 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
     check(s, "observation");
     truncated_ = truncated_ || s == CYL_TRUNCATED;
     obs_.resize(n);
+    // clutter gates
+    const bool masked = !config_.mask.empty();
+    if (masked && (config_.mask_width != img.width || config_.mask_height != img.height))
+        throw Error("detector: the mask is " + std::to_string(config_.mask_width) + "x" +
+                    std::to_string(config_.mask_height) + " px but the frame is " + std::to_string(img.width) + "x" +
+                    std::to_string(img.height) + " px");
+    size_t k = 0;
+    for (size_t i = 0; i < obs_.size(); i++) {
+        const cyl_observation &o = obs_[i];
+        const cyl_blob &b = seg_.blobs[o.blob];
+        const ClassGate &g = config_.gate[o.cls];
+        bool keep = blob_passes(config_, b, img.width, img.height);
+        if (keep && g.size_gate > 0 && o.w_est_px > 0 && o.h_est_px > 0) {
+            const double f = g.size_gate;
+            const bool edge = (b.flags & CYL_BLOB_TOUCH_ANY) != 0;
+            if (o.w_px > f * o.w_est_px && o.h_px > f * o.h_est_px) keep = false;
+            if (!edge && o.w_px * f < o.w_est_px && o.h_px * f < o.h_est_px) keep = false;
+        }
+        if (keep) obs_[k++] = o;
+        else rejected_++;
+    }
+    obs_.resize(k);
     return obs_;
+}
+
+bool blob_passes(const DetectorConfig &cfg, const cyl_blob &b, uint32_t frame_width, uint32_t frame_height)
+{
+    const ClassGate &g = cfg.gate[b.cls];
+    if (g.max_area_px && b.area > g.max_area_px) return false;
+    const double w = (double)(b.x1 - b.x0 + 1u), h = (double)(b.y1 - b.y0 + 1u);
+    if (!(b.flags & CYL_BLOB_TOUCH_ANY)) {
+        if (g.aspect_min > 0 && w < g.aspect_min * h) return false;
+        if (g.aspect_max > 0 && w > g.aspect_max * h) return false;
+    }
+    if (g.min_fill > 0 && (double)b.area < g.min_fill * w * h) return false;
+    if (!cfg.mask.empty() && cfg.mask_width == frame_width && cfg.mask_height == frame_height) {
+        long x = std::lround(b.cx_px), y = std::lround(b.cy_px);
+        if (x >= 0 && y >= 0 && x < (long)frame_width && y < (long)frame_height &&
+            cfg.mask[(size_t)y * frame_width + (size_t)x] == 0)
+            return false;
+    }
+    return true;
+}
+
+void load_detector_mask(const std::string &path, DetectorConfig &cfg)
+{
+    cv::Mat m = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    if (m.empty()) throw Error(path + ": cannot read the mask image");
+    cfg.mask.assign(m.total(), 0);
+    for (int y = 0; y < m.rows; y++)
+        for (int x = 0; x < m.cols; x++) cfg.mask[(size_t)y * m.cols + x] = m.at<uint8_t>(y, x) ? 1 : 0;
+    cfg.mask_width = (uint32_t)m.cols;
+    cfg.mask_height = (uint32_t)m.rows;
 }
 
 // ---- observation log ------------------------------------------------------------------
@@ -134,7 +193,7 @@ ObservationLog::ObservationLog(const std::string &path, const Header &h) : path_
         f_ = std::fopen(part_.c_str(), "w");
         if (!f_) throw Error(part_ + ": cannot create: " + std::strerror(errno));
     }
-    std::string line = "{\"type\":\"header\",\"format\":\"cyl-observations\",\"version\":1,\"source\":" + str(h.source) +
+    std::string line = "{\"type\":\"header\",\"format\":\"cyl-observations\",\"version\":2,\"source\":" + str(h.source) +
                        ",\"model\":" + str(h.model) + ",\"estimator\":" + str(h.estimator) + ",\"classes\":[";
     for (int i = 0; i < CYL_MAX_CLASSES; i++) {
         if (i) line += ",";
@@ -184,7 +243,8 @@ private:
 
 } // namespace
 
-void ObservationLog::frame(uint64_t seq, int64_t t_ns, const std::vector<cyl_observation> &obs)
+void ObservationLog::frame(uint64_t seq, int64_t t_ns, const std::vector<cyl_observation> &obs,
+                           const cyl_segmentation *seg)
 {
     const std::string t = t_sec(t_ns);
     write(JsonLine("frame").integer("seq", seq).raw("t", t).integer("n_obs", obs.size()).done());
@@ -198,6 +258,11 @@ void ObservationLog::frame(uint64_t seq, int64_t t_ns, const std::vector<cyl_obs
         l.num("confidence", o.confidence).num("u_px", o.u_px).num("v_px", o.v_px);
         l.num("var_u_px2", o.var_u_px2).num("var_v_px2", o.var_v_px2);
         l.integer("area_px", o.area).integer("flags", o.flags);
+        if (seg && o.blob < seg->n_blobs) {
+            const cyl_blob &b = seg->blobs[o.blob];
+            l.raw("bbox_px", "[" + std::to_string(b.x0) + "," + std::to_string(b.y0) + "," + std::to_string(b.x1) + "," +
+                                 std::to_string(b.y1) + "]");
+        }
         std::string jm = "[", cf = "[";
         for (int a = 0; a < 2; a++)
             for (int k = 0; k < CYL_CALIB_COUNT; k++) {

@@ -78,6 +78,16 @@ const char *kUsage =
     "                       model-error term for the centroid's geometric bias (docs/synthetic.md)\n"
     "  --overlay DIR|FILE.avi   write overlay images (PNG per frame) or a video\n"
     "  --show               show the overlay in a window (needs a display; q or Esc stops)\n"
+    "clutter rejection (per class with CLASS=VALUE, every class with VALUE; the command line\n"
+    "overrides --config):\n"
+    "  --config FILE.yaml   detector config file: all of the below per class (docs/formats.md)\n"
+    "  --roi X,Y,W,H        look only inside this rectangle, px\n"
+    "  --mask FILE.png      blobs whose centroid falls on a zero pixel are dropped (the robot's body)\n"
+    "  --min-area [C=]N     drop blobs under N px (default 9)\n"
+    "  --max-area [C=]N     drop blobs over N px (default: no limit)\n"
+    "  --merge-gap [C=]N    merge blobs of a class whose boxes are <= N px apart (default 3; -1 off)\n"
+    "  --size-gate [C=]F    drop a blob more than F times larger (or, away from the frame's edges,\n"
+    "                       smaller) than a landmark of the class's --size at its range (default 0: off)\n"
     "  --max-frames N       stop after N frames\n"
     "  --realtime           replay raw logs at the recorded pace (default: as fast as possible)\n"
     "  --quiet              no progress or summary on stderr\n"
@@ -94,7 +104,8 @@ const char *kUsage =
 
 struct Args {
     std::string cmd, source, table, calib, out = "-", overlay, model = "exact", estimator = "image";
-    std::vector<std::string> sizes, controls;
+    std::string config, roi, mask;
+    std::vector<std::string> sizes, controls, min_area, max_area, merge_gap, size_gate;
     double var_floor_px2 = 0.0;
     uint64_t max_frames = 0;
     bool show = false, quiet = false, fixed_exposure = false, lenient = false;
@@ -144,6 +155,13 @@ Args parse(int argc, char **argv)
         else if (s == "--model") a.model = val(s);
         else if (s == "--estimator") a.estimator = val(s);
         else if (s == "--size") a.sizes.push_back(val(s));
+        else if (s == "--config") a.config = val(s);
+        else if (s == "--roi") a.roi = val(s);
+        else if (s == "--mask") a.mask = val(s);
+        else if (s == "--min-area") a.min_area.push_back(val(s));
+        else if (s == "--max-area") a.max_area.push_back(val(s));
+        else if (s == "--merge-gap") a.merge_gap.push_back(val(s));
+        else if (s == "--size-gate") a.size_gate.push_back(val(s));
         else if (s == "--centroid-var-floor") {
             a.var_floor_px2 = parse_double(s, val(s));
             if (a.var_floor_px2 < 0) usage_error("--centroid-var-floor: must be >= 0 px^2");
@@ -236,6 +254,58 @@ void apply_v4l2_options(Source &src, const Args &a, bool quiet)
     }
 }
 
+// [CLASS=]VALUE options: one class, or every class without CLASS=.
+template <typename F>
+void per_class(const std::vector<std::string> &opts, const char *name, const cyl_colortable &table,
+               const std::string &table_path, F apply)
+{
+    for (const std::string &o : opts) {
+        size_t eq = o.find('=');
+        std::string v = eq == std::string::npos ? o : o.substr(eq + 1);
+        double x = parse_double(name, v);
+        if (eq == std::string::npos) {
+            for (unsigned k = 0; k < CYL_MAX_CLASSES; k++) apply(k, x, v);
+            continue;
+        }
+        int cls = cyl_colortable_find_class(&table, o.substr(0, eq).c_str());
+        if (cls < 0) usage_error(std::string(name) + ": class '" + o.substr(0, eq) + "' is not in " + table_path);
+        apply((unsigned)cls, x, v);
+    }
+}
+
+void apply_clutter_options(const Args &a, const cyl_colortable &table, const std::string &table_path, DetectorConfig &cfg)
+{
+    if (!a.roi.empty()) {
+        unsigned x, y, w, h;
+        char c1, c2, c3, end;
+        if (std::sscanf(a.roi.c_str(), "%u%c%u%c%u%c%u%c", &x, &c1, &y, &c2, &w, &c3, &h, &end) != 7 || c1 != ',' ||
+            c2 != ',' || c3 != ',' || !w || !h)
+            usage_error("--roi: expected X,Y,W,H in px (W, H > 0), got '" + a.roi + "'");
+        cfg.segment.roi = {x, y, w, h};
+    }
+    if (!a.mask.empty()) load_detector_mask(a.mask, cfg);
+    auto whole = [](const char *name, double x, const std::string &v, double lo) {
+        if (!(x >= lo && x <= 1e9 && x == std::floor(x)))
+            usage_error(std::string(name) + ": expected a whole number >= " + std::to_string((int)lo) + ", got '" + v + "'");
+    };
+    per_class(a.min_area, "--min-area", table, table_path, [&](unsigned k, double x, const std::string &v) {
+        whole("--min-area", x, v, 0);
+        cfg.segment.cls[k].min_area = (uint32_t)x;
+    });
+    per_class(a.max_area, "--max-area", table, table_path, [&](unsigned k, double x, const std::string &v) {
+        whole("--max-area", x, v, 0);
+        cfg.gate[k].max_area_px = (uint32_t)x;
+    });
+    per_class(a.merge_gap, "--merge-gap", table, table_path, [&](unsigned k, double x, const std::string &v) {
+        whole("--merge-gap", x, v, -1);
+        cfg.segment.cls[k].merge_gap_px = (int32_t)x;
+    });
+    per_class(a.size_gate, "--size-gate", table, table_path, [&](unsigned k, double x, const std::string &v) {
+        if (!(x == 0 || (x >= 1 && x <= 100))) usage_error("--size-gate: 0 (off) or a factor >= 1, got '" + v + "'");
+        cfg.gate[k].size_gate = x;
+    });
+}
+
 int cmd_detect(const Args &a)
 {
     if (a.source.empty()) usage_error("detect: no SOURCE given");
@@ -256,6 +326,8 @@ int cmd_detect(const Args &a)
 
     cyl_colortable table = load_table(table_path);
     DetectorConfig cfg;
+    if (!a.config.empty()) load_detector_config(a.config, table, cfg);
+    apply_clutter_options(a, table, table_path, cfg);
     cfg.observe.model = model;
     cfg.observe.estimator = est;
     cfg.observe.min_var_px2 = a.var_floor_px2;
@@ -336,7 +408,7 @@ int cmd_detect(const Args &a)
         switch (ev.kind) {
         case RecordType::Frame: {
             const std::vector<cyl_observation> &obs = det.process(ev.image);
-            log.frame(ev.header.seq, ev.header.t_ns, obs);
+            log.frame(ev.header.seq, ev.header.t_ns, obs, &det.segmentation());
             frames++;
             observations += obs.size();
             truncated += det.truncated();

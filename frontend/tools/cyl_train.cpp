@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // cyl-train: colour-table training (paper section 3.3) from image files or raw-log frames, on the
 // command line or interactively in a window. Writes libcyl's CYLT table. docs/calibration.md.
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -16,6 +17,8 @@
 #include "cylfe/version.hpp"
 #include "cylfe/calib.hpp"
 #include "cylfe/error.hpp"
+#include "cylfe/learn.hpp"
+#include "cylfe/progress.hpp"
 
 using namespace cylfe;
 using namespace cylfe::calib;
@@ -23,11 +26,43 @@ using namespace cylfe::calib;
 namespace {
 
 const char *kUsage =
-    "usage: cyl-train -o TABLE.cylt [--base IN.cylt] [params] STEP...\n"
+    "usage: cyl-train learn -o TABLE.cylt --class NAME=LABEL... [options] IMAGE|DIR|LIST...\n"
+    "       cyl-train -o TABLE.cylt [--base IN.cylt] [params] STEP...\n"
     "       cyl-train --gui IMAGE|LOG.cylraw [--frame N] -o TABLE.cylt [--base IN.cylt] [--class NAME]...\n"
     "       cyl-train --help | --version\n"
     "\n"
-    "Trains libcyl colour classes (cyl_colortable_train: a UV histogram of the region, thresholded,\n"
+    "learn (the recommended way, docs/colour-learning.md): learns each class from the labelled\n"
+    "boxes of several images (YOLO label files: DIR/labels/STEM.txt for DIR/images/STEM.jpg, or\n"
+    "STEM.txt beside the image) against the background (every pixel outside the learned classes'\n"
+    "boxes): a likelihood ratio over a 3-D YUV table, thresholded at a background false-positive\n"
+    "rate (cyl/colorlearn.h). Prints a report per class. Options:\n"
+    "  --class NAME=LABEL[@INDEX]  learn class NAME from the boxes with label id LABEL (repeatable;\n"
+    "                      INDEX: its table index, lower wins where box classes overlap)\n"
+    "  --fpr F             share of background pixels a class may claim (default 0.001)\n"
+    "  --smooth S          smoothing of the colour histograms, cells (default 1)\n"
+    "  --min-ratio R       never claim a colour less than R times likelier in the class (default 4)\n"
+    "  --weak-fpr F        share of background the class and its weak class NAME~ may claim together\n"
+    "                      (default 0.02); weak pixels count only where they touch the class's own\n"
+    "  --unseen W          weight of a uniform colour density in the background model: how likely a\n"
+    "                      colour never seen in training is background (default 0.02)\n"
+    "  --min-weak-ratio R  never give the weak class a colour less than R times likelier in the class\n"
+    "                      (default 1)\n"
+    "  --no-weak           no weak class\n"
+    "  --gains G1,G2,...   count every training pixel as it would look at each of these exposure gains\n"
+    "                      (the light or exposure changing; default 1 = as it is)\n"
+    "  --inset F           trim F of each box's size off every side before counting (default 0)\n"
+    "  --negatives PATH    extra background-only images (file, directory or .list; repeatable)\n"
+    "  --all-boxes-ignored boxes of labels not learned are left out of the background (default:\n"
+    "                      they are background: a yellow shirt teaches the ball class what not to be)\n"
+    "  --report FILE.json  also write the report as JSON\n"
+    "  --config-out FILE.yaml  write a detector config (cyl detect --config, cyl-score --config) with\n"
+    "                      each class's blob shape gate from its boxes: aspect_range = the boxes'\n"
+    "                      width/height range widened by --aspect-margin (default 1.5) each way,\n"
+    "                      min_fill (default 0.3) and merge_gap_px (default 3)\n"
+    "  --aspect-margin M, --min-fill F, --merge-gap N   (for --config-out)\n"
+    "  --base IN.cylt      start from this table; -q quiet; -o required\n"
+    "\n"
+    "rectangles (the paper's method, cyl_colortable_train: a UV histogram of the region, thresholded,\n"
     "its bounding rectangle grown by a margin, and a Y window from the brightness quantiles) and\n"
     "writes the table (CYLT format, libcyl/include/cyl/colortable.h) via a temporary file + rename.\n"
     "Train on what the detector sees: for a V4L2 YUYV camera, record a raw log (cyl record) and\n"
@@ -310,9 +345,124 @@ int run_gui(Opts &o, cyl_colortable &t, const cyl_train_params &params)
 
 } // namespace
 
+// ---- learn: classes from labelled images ------------------------------------------------------
+
+int learn_main(int argc, char **argv)
+{
+    std::string out, base, report, config_out;
+    double aspect_margin = 1.5, min_fill = 0.3;
+    long merge_gap = 3;
+    std::vector<learn::ClassSpec> classes;
+    std::vector<std::string> inputs, negatives;
+    learn::LearnOptions lo;
+    bool quiet = false;
+    try {
+        for (int i = 2; i < argc; i++) {
+            std::string s = argv[i];
+            auto next = [&]() -> std::string {
+                if (i + 1 >= argc) throw Usage(s + ": missing value");
+                return argv[++i];
+            };
+            if (s == "-h" || s == "--help") { std::fputs(kUsage, stdout); return kExitOk; }
+            else if (s == "-o" || s == "--out") out = next();
+            else if (s == "--base") base = next();
+            else if (s == "--report") report = next();
+            else if (s == "--config-out") config_out = next();
+            else if (s == "--aspect-margin") aspect_margin = parse_num(s, next(), 1, 100, false);
+            else if (s == "--min-fill") min_fill = parse_num(s, next(), 0, 1, false);
+            else if (s == "--merge-gap") merge_gap = (long)parse_num(s, next(), -1, 1000, true);
+            else if (s == "-q" || s == "--quiet") quiet = true;
+            else if (s == "--fpr") lo.params.max_bg_fraction = parse_num(s, next(), 0, 1, false);
+            else if (s == "--smooth") lo.params.smooth_sigma_cells = parse_num(s, next(), 0, 2, false);
+            else if (s == "--min-ratio") lo.params.min_likelihood_ratio = parse_num(s, next(), 0, 1e9, false);
+            else if (s == "--inset") lo.inset = parse_num(s, next(), 0, 0.45, false);
+            else if (s == "--negatives") negatives.push_back(next());
+            else if (s == "--all-boxes-ignored") lo.other_boxes_negative = false;
+            else if (s == "--no-weak") lo.weak = false;
+            else if (s == "--gains") {
+                std::string v = next();
+                lo.gains.clear();
+                size_t pos = 0;
+                while (pos <= v.size()) {
+                    size_t c = v.find(',', pos);
+                    lo.gains.push_back(parse_num("--gains", v.substr(pos, c == std::string::npos ? std::string::npos : c - pos),
+                                                 0.1, 10, false));
+                    if (c == std::string::npos) break;
+                    pos = c + 1;
+                }
+            }
+            else if (s == "--weak-fpr") lo.params.weak_bg_fraction = parse_num(s, next(), 0, 1, false);
+            else if (s == "--unseen") lo.params.bg_uniform_weight = parse_num(s, next(), 0, 1, false);
+            else if (s == "--min-weak-ratio") lo.params.min_weak_ratio = parse_num(s, next(), 0, 1e9, false);
+            else if (s == "--class") {
+                std::string v = next();
+                size_t eq = v.find('=');
+                if (eq == std::string::npos || eq == 0) throw Usage("--class: expected NAME=LABEL[@INDEX], got '" + v + "'");
+                learn::ClassSpec c;
+                c.name = v.substr(0, eq);
+                std::string rest = v.substr(eq + 1);
+                size_t at = rest.find('@');
+                c.label = (int)parse_num("--class " + c.name + " label", rest.substr(0, at), 0, 1e6, true);
+                if (at != std::string::npos)
+                    c.index = (int)parse_num("--class " + c.name + " index", rest.substr(at + 1), 0, CYL_MAX_CLASSES - 1, true);
+                if (c.name.size() >= CYL_CLASS_NAME_LEN)
+                    throw Usage("--class: name must be 1.." + std::to_string(CYL_CLASS_NAME_LEN - 1) + " bytes");
+                for (const auto &o : classes)
+                    if (o.name == c.name) throw Usage("--class " + c.name + " given twice");
+                classes.push_back(c);
+            } else if (!s.empty() && s[0] == '-') throw Usage("unknown argument '" + s + "'");
+            else inputs.push_back(s);
+        }
+        if (out.empty()) throw Usage("-o TABLE.cylt is required");
+        if (classes.empty()) throw Usage("give at least one --class NAME=LABEL");
+        if (inputs.empty()) throw Usage("give the training images (files, directories or .list files)");
+    } catch (const Usage &e) {
+        std::fprintf(stderr, "cyl-train: %s\n(cyl-train --help for usage)\n", e.what());
+        return kExitUsage;
+    }
+    try {
+        cyl_colortable t;
+        cyl_colortable_init(&t);
+        if (!base.empty()) load_table(base, t);
+        std::vector<std::string> images = learn::expand_images(inputs);
+        lo.negative_images = learn::expand_images(negatives);
+        cylfe::Progress bar(!quiet, "learning", "images");
+        const auto t0 = std::chrono::steady_clock::now();
+        learn::LearnResult r = learn::learn_from_labels(t, images, classes, lo, [&](size_t k, size_t n) {
+            double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            bar.update((double)k / (double)n, k, s > 0 ? (double)k / s : 0.0);
+        });
+        bar.done();
+        save_table(out, t);
+        if (!report.empty()) write_file_atomic(report, learn::report_json(r, t) + "\n");
+        if (!config_out.empty()) {
+            DetectorConfig cfg;
+            for (const learn::ClassReport &c : r.classes) {
+                cfg.segment.cls[c.index].merge_gap_px = (int32_t)merge_gap;
+                cfg.gate[c.index].min_fill = min_fill;
+                if (c.aspect_max > 0) {
+                    cfg.gate[c.index].aspect_min = c.aspect_min / aspect_margin;
+                    cfg.gate[c.index].aspect_max = c.aspect_max * aspect_margin;
+                }
+            }
+            write_file_atomic(config_out, detector_config_yaml(cfg, t, "cyl detector config written by cyl-train learn "
+                                                                       "(blob shape gates from the labelled boxes)"));
+        }
+        if (!quiet) {
+            std::fputs(learn::report_text(r, t).c_str(), stdout);
+            std::printf("wrote %s\n", out.c_str());
+        }
+        return kExitOk;
+    } catch (const std::exception &e) {
+        std::fprintf(stderr, "cyl-train: error: %s\n", e.what());
+        return kExitFailure;
+    }
+}
+
 int main(int argc, char **argv)
 {
     if (cylfe::print_version_if_asked(argc, argv, "cyl-train")) return 0;
+    if (argc >= 2 && std::string(argv[1]) == "learn") return learn_main(argc, argv);
     Opts o;
     std::vector<std::pair<std::string, std::string>> steps;  // (option, value) in order
     try {

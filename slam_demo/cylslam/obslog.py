@@ -36,7 +36,8 @@ import numpy as np
 from .data import FLAG_INVALID, FLAG_NO_RANGE, Dataset, Obs, Step
 
 FORMAT = "cyl-observations"
-VERSION = 1
+VERSION = 2            # what the writer below writes
+READ_VERSIONS = (1, 2)  # version 2 adds each observation's blob box, bbox_px (not used here)
 
 
 class ObsLogError(Exception):
@@ -324,9 +325,9 @@ def parse_obslog(raw: bytes, path="<bytes>", skip_bad=False, bridge_gaps=False) 
                                       "(type 'header')")
                 if rec.get("format") != FORMAT:
                     raise ObsLogError(f"{where}: format {rec.get('format')!r}, expected {FORMAT!r}")
-                if rec.get("version") != VERSION:
+                if rec.get("version") not in READ_VERSIONS:
                     raise ObsLogError(f"{where}: unsupported version {rec.get('version')!r} "
-                                      f"(this reader knows version {VERSION})")
+                                      f"(this reader knows versions {', '.join(map(str, READ_VERSIONS))})")
                 calib_cov = _check_header(rec, where)
                 header = rec
                 continue

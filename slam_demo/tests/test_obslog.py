@@ -135,9 +135,9 @@ def test_missing_file_is_an_obslog_error(tmp_path):
 
 
 def test_header_version_and_format_checked(tmp_path):
-    p = tmp_path / "v2.jsonl"
-    p.write_text('{"type":"header","format":"cyl-observations","version":2}\n')
-    with pytest.raises(ObsLogError, match=r"v2.jsonl:1: unsupported version 2"):
+    p = tmp_path / "v3.jsonl"
+    p.write_text('{"type":"header","format":"cyl-observations","version":3}\n')
+    with pytest.raises(ObsLogError, match=r"v3.jsonl:1: unsupported version 3"):
         read_obslog(str(p))
     p.write_text('{"type":"header","format":"other","version":1}\n')
     with pytest.raises(ObsLogError, match=r":1: format 'other'"):

@@ -239,7 +239,7 @@ TEST(ObservationLog, LinesAreJsonAndRenamedOnClose)
     std::vector<std::string> lines;
     for (std::string l; std::getline(f, l);) lines.push_back(l);
     ASSERT_EQ(lines.size(), 5u);
-    EXPECT_NE(lines[0].find("\"format\":\"cyl-observations\",\"version\":1"), std::string::npos);
+    EXPECT_NE(lines[0].find("\"format\":\"cyl-observations\",\"version\":2"), std::string::npos);
     EXPECT_NE(lines[0].find("\"or\\\"ange\""), std::string::npos);  // escaped quote
     EXPECT_NE(lines[1].find("{\"type\":\"frame\",\"seq\":3,\"t\":1.500000000,\"n_obs\":2}"), std::string::npos);
     EXPECT_NE(lines[2].find("\"range_m\":2.5,\"bearing_rad\":-0.25,\"cov_rr\":0.01,\"cov_rb\":0.0001,\"cov_bb\":0.0004"),

@@ -16,13 +16,42 @@ extern "C" {
 
 namespace cylfe {
 
+// Clutter rejection after segmentation, per class (the segmentation's own rules -- region of
+// interest, minimum area, merging -- live in DetectorConfig::segment).
+struct ClassGate {
+    uint32_t max_area_px = 0;   // drop blobs larger than this, px (0: no limit)
+    double aspect_min = 0.0;    // drop blobs whose box width/height is below this (0: off) ...
+    double aspect_max = 0.0;    // ... or above this (0: off); blobs touching the frame's edges are kept
+    double min_fill = 0.0;      // drop blobs covering less than this share of their box (0: off)
+    double size_gate = 0.0;     // drop an observation whose blob is more than size_gate times larger,
+                                // or (untouched by the frame's edges) smaller, than a landmark of the
+                                // class at its measured range in both width and height (0: off)
+};
+
 struct DetectorConfig {
     cyl_segment_params segment = cyl_segment_params_default();
     cyl_observe_params observe = cyl_observe_params_default();
+    ClassGate gate[CYL_MAX_CLASSES];
+    std::vector<uint8_t> mask;   // width*height bytes, 0 = not a landmark (the robot's own body); empty: none
+    uint32_t mask_width = 0, mask_height = 0;
     uint32_t max_runs = 65536;   // run capacity per frame
     uint32_t max_blobs = 4096;   // blob capacity per frame
     uint32_t max_observations = 1024;
 };
+
+// The gates that need no camera (area, aspect, fill, mask) on one blob of a frame.
+bool blob_passes(const DetectorConfig &cfg, const cyl_blob &b, uint32_t frame_width, uint32_t frame_height);
+
+// Read a detector config file (YAML, docs/formats.md) into cfg, naming the class indices through
+// table. Unknown keys and classes are errors naming the line; the mask path is relative to the
+// file's folder.
+void load_detector_config(const std::string &path, const cyl_colortable &table, DetectorConfig &cfg);
+
+// The detector config file's text for cfg (what differs from the defaults), for the classes of table.
+std::string detector_config_yaml(const DetectorConfig &cfg, const cyl_colortable &table, const std::string &comment);
+
+// Load a mask image (any OpenCV-readable format; non-zero = keep) into cfg.
+void load_detector_mask(const std::string &path, DetectorConfig &cfg);
 
 // Owns the caller-side memory libcyl needs and runs segmentation + observation per frame.
 class Detector {
@@ -36,6 +65,7 @@ public:
     const cyl_camera &camera() const { return camera_; }
     const DetectorConfig &config() const { return config_; }
     bool truncated() const { return truncated_; }
+    uint64_t rejected() const { return rejected_; }   // observations the gates dropped so far
 
 private:
     cyl_colortable table_;
@@ -45,6 +75,7 @@ private:
     cyl_segmentation seg_{};
     std::vector<cyl_observation> obs_;
     bool truncated_ = false;
+    uint64_t rejected_ = 0;
 };
 
 // JSON Lines observation log. path "-" writes to stdout; otherwise it writes "<path>.part"
@@ -63,7 +94,9 @@ public:
     ObservationLog(const ObservationLog &) = delete;
     ObservationLog &operator=(const ObservationLog &) = delete;
 
-    void frame(uint64_t seq, int64_t t_ns, const std::vector<cyl_observation> &obs);
+    // seg: the segmentation the observations came from (for their blobs' boxes), or null
+    void frame(uint64_t seq, int64_t t_ns, const std::vector<cyl_observation> &obs,
+               const cyl_segmentation *seg = nullptr);
     void odometry(uint64_t seq, int64_t t_ns, const Odometry &o);
     void truth_pose(uint64_t seq, int64_t t_ns, const TruthPose &p);
     void truth_landmark(const TruthLandmark &l);

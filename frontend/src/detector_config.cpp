@@ -1,0 +1,209 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The detector config file (docs/formats.md, "Detector config"): the segmentation's and the
+// clutter gates' settings per class, read strictly (pipeline.hpp).
+#include "cylfe/pipeline.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "cylfe/error.hpp"
+#include "cylfe/keys.hpp"
+
+namespace cylfe {
+
+namespace {
+
+struct Reader {
+    std::string path;
+
+    std::string at(const YAML::Node &n) const { return path + ":" + std::to_string(n.Mark().line + 1); }
+
+    [[noreturn]] void fail(const YAML::Node &n, const std::string &what) const { throw Error(at(n) + ": " + what); }
+
+    // Keys of a mapping: duplicates and unknown keys are errors naming the nearest known one.
+    void keys(const YAML::Node &m, const std::string &where, const std::vector<std::string> &known) const
+    {
+        if (!m.IsMap()) fail(m, where + ": expected a mapping");
+        std::map<std::string, int> seen;
+        for (auto it = m.begin(); it != m.end(); ++it) {
+            if (!it->first.IsScalar()) fail(it->first, where + ": a key that is not a plain name");
+            const std::string k = it->first.Scalar();
+            const int line = it->first.Mark().line + 1;
+            if (seen.count(k))
+                fail(it->first, where + ": key '" + k + "' given twice (lines " + std::to_string(seen[k]) + " and " +
+                                    std::to_string(line) + ")");
+            seen[k] = line;
+            if (!known.empty() && std::find(known.begin(), known.end(), k) == known.end())
+                fail(it->first, where + ": unknown key '" + k + "'" + did_you_mean(k, known));
+        }
+    }
+
+    double number(const YAML::Node &n, const std::string &field, double lo, double hi, bool integer) const
+    {
+        double v = 0;
+        if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v))
+            fail(n, field + ": expected a number");
+        if (v < lo || v > hi || (integer && v != std::floor(v)))
+            fail(n, field + ": " + n.Scalar() + " is out of range [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                        "]" + (integer ? " or not a whole number" : ""));
+        return v;
+    }
+
+    std::vector<double> list(const YAML::Node &n, const std::string &field, size_t count, double lo, double hi,
+                             bool integer) const
+    {
+        if (!n.IsSequence() || n.size() != count)
+            fail(n, field + ": expected a list of " + std::to_string(count) + " numbers");
+        std::vector<double> v;
+        for (const YAML::Node &e : n) v.push_back(number(e, field, lo, hi, integer));
+        return v;
+    }
+};
+
+const std::vector<std::string> kTop = {"roi", "mask", "min_run_px", "classes"};
+const std::vector<std::string> kClass = {"min_area_px", "max_area_px", "merge_gap_px", "merge_min_density", "size_m",
+                                         "size_gate", "aspect_range", "min_fill"};
+
+void read_class(const Reader &r, const YAML::Node &n, const std::string &where, DetectorConfig &cfg, unsigned k)
+{
+    r.keys(n, where, kClass);
+    cyl_class_params &cp = cfg.segment.cls[k];
+    ClassGate &g = cfg.gate[k];
+    if (n["min_area_px"]) cp.min_area = (uint32_t)r.number(n["min_area_px"], where + ".min_area_px", 0, 1e9, true);
+    if (n["max_area_px"]) g.max_area_px = (uint32_t)r.number(n["max_area_px"], where + ".max_area_px", 0, 1e9, true);
+    if (n["merge_gap_px"]) cp.merge_gap_px = (int32_t)r.number(n["merge_gap_px"], where + ".merge_gap_px", -1, 1000, true);
+    if (n["merge_min_density"])
+        cp.merge_min_density = r.number(n["merge_min_density"], where + ".merge_min_density", 0, 1, false);
+    if (n["size_m"]) {
+        std::vector<double> v = r.list(n["size_m"], where + ".size_m", 2, 1e-6, 1e3, false);
+        cfg.observe.size[k].diameter_m = v[0];
+        cfg.observe.size[k].height_m = v[1];
+    }
+    if (n["aspect_range"]) {
+        std::vector<double> v = r.list(n["aspect_range"], where + ".aspect_range", 2, 0, 1e4, false);
+        if (v[0] > v[1]) r.fail(n["aspect_range"], where + ".aspect_range: [low, high] with low <= high");
+        g.aspect_min = v[0];
+        g.aspect_max = v[1];
+    }
+    if (n["min_fill"]) g.min_fill = r.number(n["min_fill"], where + ".min_fill", 0, 1, false);
+    if (n["size_gate"]) {
+        g.size_gate = r.number(n["size_gate"], where + ".size_gate", 0, 100, false);
+        if (g.size_gate > 0 && g.size_gate < 1) r.fail(n["size_gate"], where + ".size_gate: 0 (off) or >= 1");
+    }
+}
+
+} // namespace
+
+void load_detector_config(const std::string &path, const cyl_colortable &table, DetectorConfig &cfg)
+{
+    std::ifstream f(path, std::ios::binary);
+    if (!f) throw Error(path + ": cannot open detector config file");
+    std::stringstream ss;
+    ss << f.rdbuf();
+    const std::string text = ss.str();
+    if (text.size() > (1u << 20)) throw Error(path + ": not a detector config file: larger than 1 MiB");
+    int depth = 0, max_depth = 0;
+    for (char ch : text) {
+        if (ch == '[' || ch == '{') max_depth = std::max(max_depth, ++depth);
+        else if ((ch == ']' || ch == '}') && depth > 0) depth--;
+    }
+    if (max_depth > 8) throw Error(path + ": not a detector config file: nested more than 8 levels");
+    YAML::Node root;
+    try {
+        root = YAML::Load(text);
+    } catch (const YAML::Exception &e) {
+        throw Error(path + ": not readable YAML: " + e.what());
+    }
+    if (root.IsNull()) return;   // an empty file: the defaults
+    Reader r{path};
+    r.keys(root, "top level", kTop);
+    if (root["roi"]) {
+        std::vector<double> v = r.list(root["roi"], "roi", 4, 0, CYL_MAX_DIM, true);
+        cfg.segment.roi.x = (uint32_t)v[0];
+        cfg.segment.roi.y = (uint32_t)v[1];
+        cfg.segment.roi.width = (uint32_t)v[2];
+        cfg.segment.roi.height = (uint32_t)v[3];
+        if (v[2] == 0 || v[3] == 0) r.fail(root["roi"], "roi: width and height must be > 0");
+    }
+    if (root["min_run_px"]) cfg.segment.min_run_px = (uint16_t)r.number(root["min_run_px"], "min_run_px", 1, 1000, true);
+    if (root["mask"]) {
+        const YAML::Node m = root["mask"];
+        if (!m.IsScalar() || m.Scalar().empty()) r.fail(m, "mask: expected a file name");
+        std::string mp = m.Scalar();
+        size_t slash = path.find_last_of('/');
+        if (mp[0] != '/' && slash != std::string::npos) mp = path.substr(0, slash + 1) + mp;
+        try {
+            load_detector_mask(mp, cfg);
+        } catch (const Error &e) {
+            throw Error(r.at(m) + ": mask: " + e.what());
+        }
+    }
+    if (root["classes"]) {
+        const YAML::Node cl = root["classes"];
+        std::vector<std::string> names = {"all"};
+        for (unsigned k = 0; k < CYL_MAX_CLASSES; k++)
+            if (table.name[k][0]) names.push_back(table.name[k]);
+        r.keys(cl, "classes", names);
+        if (cl["all"])
+            for (unsigned k = 0; k < CYL_MAX_CLASSES; k++) read_class(r, cl["all"], "classes.all", cfg, k);
+        for (auto it = cl.begin(); it != cl.end(); ++it) {
+            const std::string name = it->first.Scalar();
+            if (name == "all") continue;
+            read_class(r, it->second, "classes." + name, cfg, (unsigned)cyl_colortable_find_class(&table, name.c_str()));
+        }
+    }
+}
+
+std::string detector_config_yaml(const DetectorConfig &cfg, const cyl_colortable &table, const std::string &comment)
+{
+    std::string s;
+    char b[256];
+    if (!comment.empty()) s += "# " + comment + "\n";
+    const cyl_segment_params d = cyl_segment_params_default();
+    if (cfg.segment.roi.width && cfg.segment.roi.height) {
+        std::snprintf(b, sizeof b, "roi: [%u, %u, %u, %u]\n", cfg.segment.roi.x, cfg.segment.roi.y, cfg.segment.roi.width,
+                      cfg.segment.roi.height);
+        s += b;
+    }
+    if (cfg.segment.min_run_px != d.min_run_px) s += "min_run_px: " + std::to_string(cfg.segment.min_run_px) + "\n";
+    std::string cls;
+    for (unsigned k = 0; k < CYL_MAX_CLASSES; k++) {
+        if (!table.name[k][0] || table.weak_of[k] != CYL_CLASS_NONE) continue;
+        const cyl_class_params &c = cfg.segment.cls[k];
+        const ClassGate &g = cfg.gate[k];
+        std::string e;
+        if (c.min_area != d.cls[k].min_area) e += "    min_area_px: " + std::to_string(c.min_area) + "\n";
+        if (g.max_area_px) e += "    max_area_px: " + std::to_string(g.max_area_px) + "\n";
+        if (c.merge_gap_px != d.cls[k].merge_gap_px) e += "    merge_gap_px: " + std::to_string(c.merge_gap_px) + "\n";
+        if (c.merge_min_density != d.cls[k].merge_min_density) {
+            std::snprintf(b, sizeof b, "    merge_min_density: %.3g\n", c.merge_min_density);
+            e += b;
+        }
+        if (g.aspect_min > 0 || g.aspect_max > 0) {
+            std::snprintf(b, sizeof b, "    aspect_range: [%.3g, %.3g]\n", g.aspect_min, g.aspect_max);
+            e += b;
+        }
+        if (g.min_fill > 0) {
+            std::snprintf(b, sizeof b, "    min_fill: %.3g\n", g.min_fill);
+            e += b;
+        }
+        if (cfg.observe.size[k].diameter_m > 0) {
+            std::snprintf(b, sizeof b, "    size_m: [%.6g, %.6g]\n", cfg.observe.size[k].diameter_m, cfg.observe.size[k].height_m);
+            e += b;
+        }
+        if (g.size_gate > 0) {
+            std::snprintf(b, sizeof b, "    size_gate: %.3g\n", g.size_gate);
+            e += b;
+        }
+        if (!e.empty()) cls += "  " + std::string(table.name[k]) + ":\n" + e;
+    }
+    if (!cls.empty()) s += "classes:\n" + cls;
+    return s;
+}
+
+} // namespace cylfe
