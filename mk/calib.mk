@@ -82,6 +82,7 @@ calib-test: $(CALIB_TEST_BINS)
 # The interactive trainer under Xvfb (scripted mouse and keys, screenshots checked).
 TEST_EXTRA += $(STAMP)/debs-calibgui $(BUILD)/cyl-train
 TEST_EXTRA_BINS += tests/calib/gui_test.sh:$(BUILD)
+TEST_EXTRA += $(BUILD)/cyl-score
 calib-gui-test: $(STAMP)/debs-calibgui $(BUILD)/cyl-train
 	@tests/calib/gui_test.sh $(BUILD)
 .PHONY: calib-gui-test

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <string>
 #include <vector>
+#include <unistd.h>
 
 #include <opencv2/highgui.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -91,9 +92,14 @@ const char *kUsage =
     "interactive (--gui): drag a rectangle with the left button to train the current class on it;\n"
     "the classified pixels are shown in the classes' display colours. Keys:\n"
     "  0-7 select class   n next class   r rename the current class (type, Enter)\n"
-    "  u undo             c clear the current class   o overlay on/off\n"
+    "  u undo             c clear the current class   o overlay on/off   l learn mode on/off\n"
     "  s save to -o       p write the window image to --snapshot FILE   q / Esc quit\n"
     "  --snapshot FILE     where p writes the window image (default: TABLE.png)\n"
+    "  --learn             start in learn mode (key l): each box dragged is a labelled example and\n"
+    "                      the classes are learned as by `cyl-train learn` from all of them at once,\n"
+    "                      the report shown live; s also saves the boxes as YOLO labels, which\n"
+    "                      `cyl-train learn` reads (and --learn loads them again)\n"
+    "  --save-labels FILE  where s writes the labels (default: the image's STEM.txt beside it)\n"
     "  --scale S           display scale (default 1)\n"
     "\n"
     "exit codes: 0 ok, 1 failed (unreadable image or table, bad rectangle, nothing to train), 2 bad\n"
@@ -162,10 +168,10 @@ unsigned select_class(cyl_colortable &t, const std::string &name, int index)
 }
 
 struct Opts {
-    std::string out, base, gui, snapshot;
+    std::string out, base, gui, snapshot, save_labels;
     long gui_frame = 0;
     double scale = 1.0;
-    bool quiet = false;
+    bool quiet = false, gui_learn = false;
     std::vector<std::string> gui_classes;
 };
 
@@ -174,8 +180,12 @@ struct Opts {
 constexpr int kBarHeight = 54;  // px of status bar below the image
 
 struct Gui {
-    cyl_colortable table;
+    cyl_colortable table, base;                // base: the table before learn mode's classes
     std::vector<cyl_colortable> undo;
+    std::vector<std::vector<learn::Box>> undo_boxes;
+    std::vector<learn::Box> boxes;             // learn mode: the labelled boxes so far
+    bool learn = false;
+    std::string labels_path;
     Frame frame;
     unsigned cls = 0;
     bool dragging = false, overlay = true, naming = false, dirty = true;
@@ -184,6 +194,54 @@ struct Gui {
     cyl_train_params params;
     double scale = 1.0;
 };
+
+// Learn mode: learn every class that has boxes from this frame's boxes (the rest of the frame
+// is background), into the table as it was when learn mode began; the report goes to the status
+// line and stdout.
+void relearn(Gui &g)
+{
+    std::vector<learn::ClassSpec> classes;
+    for (unsigned k = 0; k < CYL_MAX_CLASSES; k++) {
+        bool has = false;
+        for (const learn::Box &b : g.boxes) has = has || b.label == (int)k;
+        if (!has) continue;
+        learn::ClassSpec c;
+        c.name = g.base.name[k][0] ? std::string(g.base.name[k]) : g.table.name[k][0] ? std::string(g.table.name[k])
+                                                                                    : "class" + std::to_string(k);
+        c.label = (int)k;
+        c.index = (int)k;
+        classes.push_back(c);
+    }
+    if (classes.empty()) { g.table = g.base; g.status = "no boxes"; return; }
+    learn::LearnOptions lo;
+    lo.weak_from_top = true;
+    std::vector<learn::LabelledFrame> frames(1);
+    frames[0].frame = g.frame;
+    frames[0].boxes = g.boxes;
+    cyl_colortable t = g.base;
+    for (const learn::ClassSpec &c : classes)
+        if (!t.name[c.index][0]) {
+            const uint8_t *col = kPalette[c.index];
+            cyl_colortable_set_class(&t, (unsigned)c.index, c.name.c_str(), col[0], col[1], col[2]);
+        }
+    try {
+        learn::LearnResult r = learn::learn_from_frames(t, frames, classes, lo);
+        g.table = t;
+        std::fputs(learn::report_text(r, t).c_str(), stdout);
+        std::fflush(stdout);
+        for (const learn::ClassReport &c : r.classes)
+            if (c.index == g.cls) {
+                char b[200];
+                std::snprintf(b, sizeof b, "learned %s from %llu box(es): recall %.0f%% (+%.0f%% weak), background %.3f%%, "
+                              "covers %.1f%% of the frame%s", c.name.c_str(), (unsigned long long)c.boxes,
+                              100 * c.r.recall, 100 * c.r.weak_recall, 100 * c.r.bg_fraction, 100 * c.worst_frame_share,
+                              c.warnings.empty() ? "" : " (warnings on stdout)");
+                g.status = b;
+            }
+    } catch (const Error &e) {
+        g.status = e.what();
+    }
+}
 
 void on_mouse(int ev, int x, int y, int, void *ud)
 {
@@ -205,6 +263,14 @@ void on_mouse(int ev, int x, int y, int, void *ud)
                    cv::Point(std::max(g.p0.x, g.p1.x) + 1, std::max(g.p0.y, g.p1.y) + 1));
         if (r.width < 3 || r.height < 3) {
             g.status = "rectangle too small";
+        } else if (g.learn) {
+            learn::Box b;
+            b.label = (int)g.cls;
+            b.x0 = r.x; b.y0 = r.y; b.x1 = r.x + r.width; b.y1 = r.y + r.height;
+            g.undo.push_back(g.table);
+            g.undo_boxes.push_back(g.boxes);
+            g.boxes.push_back(b);
+            relearn(g);
         } else {
             if (g.table.name[g.cls][0] == '\0') {
                 std::string n = "class" + std::to_string(g.cls);
@@ -235,14 +301,20 @@ cv::Mat render(const Gui &g)
 {
     cv::Mat img = g.overlay ? classified_overlay(g.table, g.frame) : classified_overlay(cyl_colortable{}, g.frame, 0);
     if (g.scale != 1.0) cv::resize(img, img, cv::Size(), g.scale, g.scale, cv::INTER_NEAREST);
+    if (g.learn)
+        for (const learn::Box &b : g.boxes) {
+            const uint8_t *c = g.table.rgb[b.label];
+            cv::rectangle(img, cv::Rect2d(b.x0 * g.scale, b.y0 * g.scale, b.width() * g.scale, b.height() * g.scale),
+                          cv::Scalar(c[2], c[1], c[0]), 1);
+        }
     if (g.dragging)
         cv::rectangle(img, cv::Point(g.p0) * g.scale, cv::Point(g.p1) * g.scale, cv::Scalar(255, 255, 255), 1);
     // status bar: the class, the keys, the last message
     cv::Mat bar(kBarHeight, img.cols, CV_8UC3, cv::Scalar(40, 40, 40));
     std::string line1 = "class " + std::to_string(g.cls) + ": " +
                         (g.naming ? g.name_buf + "_  (type the name, Enter)" : std::string(g.table.name[g.cls]));
-    std::string line2 = "drag: train  0-7/n: class  r: rename  u: undo (" + std::to_string(g.undo.size()) +
-                        ")  c: clear  o: overlay  s: save  p: snapshot  q: quit";
+    std::string line2 = std::string(g.learn ? "LEARN drag: box" : "drag: train") + "  0-7/n: class  r: rename  u: undo (" +
+                        std::to_string(g.undo.size()) + ")  c: clear  l: learn mode  o: overlay  s: save  p: snapshot  q: quit";
     const uint8_t *c = g.table.rgb[g.cls];
     cv::rectangle(bar, cv::Rect(4, 4, 12, 12), cv::Scalar(c[2], c[1], c[0]), cv::FILLED);
     cv::putText(bar, line1, cv::Point(22, 15), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(230, 230, 230), 1);
@@ -268,6 +340,22 @@ int run_gui(Opts &o, cyl_colortable &t, const cyl_train_params &params)
     cv::namedWindow(win, cv::WINDOW_AUTOSIZE | cv::WINDOW_GUI_NORMAL);  // Qt: no toolbar or status bar
     cv::setMouseCallback(win, on_mouse, &g);
     g.status = "drag a rectangle over a landmark";
+    g.base = g.table;
+    g.labels_path = o.save_labels;
+    if (g.labels_path.empty()) {   // STEM.txt beside the image: where cyl-train learn looks for it
+        size_t dot = o.gui.find_last_of('.'), slash = o.gui.find_last_of('/');
+        g.labels_path = (dot != std::string::npos && (slash == std::string::npos || dot > slash) ? o.gui.substr(0, dot) : o.gui) + ".txt";
+    }
+    if (o.gui_learn) {
+        g.learn = true;
+        if (access(g.labels_path.c_str(), R_OK) == 0) {
+            g.boxes = learn::read_yolo(g.labels_path, (int)g.frame.img.width, (int)g.frame.img.height);
+            relearn(g);
+            g.status = "loaded " + std::to_string(g.boxes.size()) + " box(es) from " + g.labels_path + "; " + g.status;
+        } else {
+            g.status = "learn mode: drag a box around each landmark";
+        }
+    }
     std::printf("cyl-train: window open (%s)\n", g.frame.label.c_str());
     std::fflush(stdout);
     for (;;) {
@@ -311,18 +399,41 @@ int run_gui(Opts &o, cyl_colortable &t, const cyl_train_params &params)
         else if (k == 'n') g.cls = (g.cls + 1) % CYL_MAX_CLASSES;
         else if (k == 'r') { g.naming = true; g.name_buf.clear(); }
         else if (k == 'o') g.overlay = !g.overlay;
-        else if (k == 'u') {
+        else if (k == 'l') {
+            g.learn = !g.learn;
+            if (g.learn) { g.base = g.table; g.boxes.clear(); g.undo_boxes.clear(); g.undo.clear(); }
+            g.status = g.learn ? "learn mode: drag a box around each landmark (the rest is background)" : "rectangle mode";
+        } else if (k == 'u') {
             if (g.undo.empty()) g.status = "nothing to undo";
-            else { g.table = g.undo.back(); g.undo.pop_back(); g.status = "undone"; }
+            else {
+                g.table = g.undo.back();
+                g.undo.pop_back();
+                if (g.learn && !g.undo_boxes.empty()) { g.boxes = g.undo_boxes.back(); g.undo_boxes.pop_back(); }
+                g.status = "undone";
+            }
         } else if (k == 'c') {
             g.undo.push_back(g.table);
-            cyl_colortable_clear_class(&g.table, g.cls);
+            if (g.learn) {
+                g.undo_boxes.push_back(g.boxes);
+                std::vector<learn::Box> keep;
+                for (const learn::Box &b : g.boxes)
+                    if (b.label != (int)g.cls) keep.push_back(b);
+                g.boxes = keep;
+                relearn(g);
+            } else {
+                cyl_colortable_clear_class(&g.table, g.cls);
+            }
             g.status = "cleared class " + std::to_string(g.cls);
         } else if (k == 's') {
             try {
                 save_table(o.out, g.table);
                 g.status = "saved " + o.out;
                 std::printf("cyl-train: saved %s\n", o.out.c_str());
+                if (g.learn && !g.boxes.empty()) {
+                    learn::write_yolo(g.labels_path, g.boxes, (int)g.frame.img.width, (int)g.frame.img.height);
+                    g.status += " and " + g.labels_path;
+                    std::printf("cyl-train: saved %s\n", g.labels_path.c_str());
+                }
             } catch (const Error &e) {
                 g.status = e.what();
             }
@@ -450,6 +561,7 @@ int learn_main(int argc, char **argv)
         }
         if (!quiet) {
             std::fputs(learn::report_text(r, t).c_str(), stdout);
+        std::fflush(stdout);
             std::printf("wrote %s\n", out.c_str());
         }
         return kExitOk;
@@ -480,6 +592,8 @@ int main(int argc, char **argv)
             else if (s == "--base") o.base = next();
             else if (s == "--gui") o.gui = next();
             else if (s == "--snapshot") o.snapshot = next();
+            else if (s == "--save-labels") o.save_labels = next();
+            else if (s == "--learn") o.gui_learn = true;
             else if (s == "--scale") o.scale = parse_num(s, next(), 0.25, 4, false);
             else if (s == "-q" || s == "--quiet") o.quiet = true;
             else if (s == "--replace") steps.emplace_back(s, "");

@@ -138,7 +138,40 @@ if [ -f "$W/snap.png" ]; then
     bad snapshot "snapshot pixel $r3,$g3,$b3"; fi
 else bad snapshot "no snapshot written"; fi
 ls "$W" | grep -q '\.tmp\.' && bad tmpfiles "temporary files left: $(ls "$W")"
-# 4. headless without a display: a clear error, exit 1
+# 4. learn mode: a box dragged is a labelled example; the classes are learned from it (report on
+# stdout and in the status line), s saves a version-2 table and the box as a YOLO label beside
+# the image; --learn loads the labels again
+cp "$W/patches.png" "$W/learn.png"
+"$TOOL" --gui "$W/learn.png" --learn -o "$W/learned.cylt" --class orange >"$W/tool.log" 2>&1 &
+TPID=$!
+wid=""
+for i in $(seq 100); do
+  wid=$(xdotool search --name '^cyl-train$' 2>/dev/null | head -1)
+  [ -n "$wid" ] && grep -q "window open" "$W/tool.log" && break
+  sleep 0.1
+done
+if [ -z "$wid" ]; then bad learnwindow "no window: $(cat "$W/tool.log")"; finish; fi
+sleep 0.5
+eval "$(xdotool getwindowgeometry --shell "$wid")"
+xdotool windowfocus --sync "$wid" 2>/dev/null || xdotool windowfocus "$wid"
+drag 40 60 99 159
+if wait_log "^orange " 1; then ok "learn mode: a box learns the class (report printed)"; else
+  bad learn "no report: $(cat "$W/tool.log")"; fi
+key s
+wait_log "saved .*learn.txt" 1 || bad learnsave "labels not saved: $(cat "$W/tool.log")"
+key q
+for i in $(seq 50); do kill -0 "$TPID" 2>/dev/null || break; sleep 0.1; done
+kill -0 "$TPID" 2>/dev/null && kill "$TPID"; TPID=""
+# the box (40..99 x 60..159 inclusive drag corners -> [40, 100) x [60, 160)) in a 320x240 image
+if [ "$(cat "$W/learn.txt" 2>/dev/null)" = "0 0.218750 0.458333 0.187500 0.416667" ]; then ok "labels saved as YOLO beside the image"
+else bad labels "learn.txt: $(cat "$W/learn.txt" 2>&1)"; fi
+if [ "$(stat -c %s "$W/learned.cylt" 2>/dev/null)" = 197036 ] &&
+   "$BUILD/cyl-score" -q --table "$W/learned.cylt" --class orange=0 "$W/learn.png" | tail -1 |
+   grep -q '"recall_iou50": 1.0000'; then
+  ok "the learned table finds the labelled patch (version 2, cyl-score recall 1)"
+else bad learned "table: $(ls -la "$W/learned.cylt" 2>&1)"; fi
+
+# 5. headless without a display: a clear error, exit 1
 out=$(env -u DISPLAY "$TOOL" --gui "$W/patches.png" -o "$W/x.cylt" 2>&1); rc=$?
 if [ $rc -eq 1 ] && echo "$out" | grep -q DISPLAY && [ ! -e "$W/x.cylt" ]; then ok "no display: clear error"; else
   bad nodisplay "exit $rc: $out"; fi

@@ -64,6 +64,7 @@ struct LearnOptions {
     std::vector<std::string> negative_images;  // extra background images (every pixel negative)
     double flood_fraction = 0.03;         // warn when a class covers more than this of a training frame
     bool weak = true;                     // give each class a weak class (hysteresis; NAME~ in the table)
+    bool weak_from_top = false;           // place weak classes at the highest free indices (else lowest)
     std::vector<double> gains{1.0};       // every training pixel counted at each of these exposure gains
                                           // (cyl_colorhist_add_scaled: photometric augmentation)
 };
@@ -86,10 +87,20 @@ struct LearnResult {
     size_t images = 0;
 };
 
+// A training frame with its boxes (frame.label names it in messages).
+struct LabelledFrame {
+    calib::Frame frame;
+    std::vector<Box> boxes;
+};
+
 // Learn the classes into t (other classes of t stay). progress(i, n) is called per image.
 LearnResult learn_from_labels(cyl_colortable &t, const std::vector<std::string> &images,
                               const std::vector<ClassSpec> &classes, const LearnOptions &o,
                               const std::function<void(size_t, size_t)> &progress = nullptr);
+
+// The same from frames in memory (cyl-train --gui).
+LearnResult learn_from_frames(cyl_colortable &t, const std::vector<LabelledFrame> &frames,
+                              const std::vector<ClassSpec> &classes, const LearnOptions &o);
 
 // Human-readable report (several lines) and one JSON object.
 std::string report_text(const LearnResult &r, const cyl_colortable &t);

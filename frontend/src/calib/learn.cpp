@@ -183,14 +183,9 @@ std::vector<std::string> expand_images(const std::vector<std::string> &args)
 
 namespace {
 
-struct Labelled {
-    calib::Frame frame;
-    std::vector<Box> boxes;
-};
-
-Labelled load_labelled(const std::string &path, bool need_labels)
+LabelledFrame load_labelled(const std::string &path, bool need_labels)
 {
-    Labelled l;
+    LabelledFrame l;
     l.frame = calib::load_frame(path);
     std::string lf = find_label_file(path);
     if (lf.empty()) {
@@ -214,13 +209,16 @@ void paint(std::vector<uint8_t> &mask, int w, int h, const Box &b, double inset,
 
 } // namespace
 
-LearnResult learn_from_labels(cyl_colortable &t, const std::vector<std::string> &images,
-                              const std::vector<ClassSpec> &classes, const LearnOptions &o,
-                              const std::function<void(size_t, size_t)> &progress)
+namespace {
+
+// The learning itself; frame(i) gives training frame i of n with its boxes.
+LearnResult learn_core(cyl_colortable &t, size_t n_images, const std::function<LabelledFrame(size_t)> &frame,
+                       const std::vector<ClassSpec> &classes, const LearnOptions &o,
+                       const std::function<void(size_t, size_t)> &progress)
 {
     if (classes.empty()) throw Error("no class to learn");
     if (classes.size() > CYL_MAX_CLASSES) throw Error("at most 8 classes");
-    if (images.empty()) throw Error("no training images");
+    if (n_images == 0) throw Error("no training images");
     if (o.gains.empty()) throw Error("no exposure gain to learn at");
     const size_t nc = classes.size();
     std::vector<std::unique_ptr<cyl_colorhist>> pos(nc);
@@ -250,10 +248,11 @@ LearnResult learn_from_labels(cyl_colortable &t, const std::vector<std::string> 
         res.classes[i].name = c.name;
         res.classes[i].index = (unsigned)index;
     }
-    const size_t total = images.size() + o.negative_images.size();
+    const size_t total = n_images + o.negative_images.size();
     size_t done = 0;
-    for (const std::string &path : images) {
-        Labelled l = load_labelled(path, true);
+    for (size_t fi = 0; fi < n_images; fi++) {
+        const LabelledFrame l = frame(fi);
+        const std::string &path = l.frame.label;
         const int w = (int)l.frame.img.width, h = (int)l.frame.img.height;
         // mask: 0 background, 1 + i class i, 255 ignored (another learned class's box, or an
         // unlearned label's box when those are not background)
@@ -297,9 +296,9 @@ LearnResult learn_from_labels(cyl_colortable &t, const std::vector<std::string> 
     for (size_t i = 0; i < nc; i++)
         if (pos[i]->total == 0)
             throw Error("class '" + classes[i].name + "' (label " + std::to_string(classes[i].label) +
-                        "): no labelled pixel in the " + std::to_string(images.size()) + " training images");
+                        "): no labelled pixel in the " + std::to_string(n_images) + " training images");
     res.negative_px = neg->total / o.gains.size();
-    res.images = images.size();
+    res.images = n_images;
 
     static const uint8_t pal[CYL_MAX_CLASSES][3] = {{255, 120, 0}, {0, 200, 60}, {0, 90, 255}, {255, 220, 0},
                                                     {220, 0, 220}, {0, 220, 220}, {255, 255, 255}, {140, 70, 20}};
@@ -317,7 +316,8 @@ LearnResult learn_from_labels(cyl_colortable &t, const std::vector<std::string> 
         std::string wn = classes[i].name.substr(0, CYL_CLASS_NAME_LEN - 2) + "~";
         int w = cyl_colortable_find_class(&t, wn.c_str());
         if (w < 0)
-            for (int k = 0; k < CYL_MAX_CLASSES; k++) {
+            for (int n = 0; n < CYL_MAX_CLASSES; n++) {
+                const int k = o.weak_from_top ? CYL_MAX_CLASSES - 1 - n : n;
                 bool used = t.name[k][0] != '\0';
                 for (size_t j = 0; j < nc; j++) used = used || idx[j] == (unsigned)k || lc[j].weak_cls == (unsigned)k;
                 if (!used) { w = k; break; }
@@ -340,8 +340,10 @@ LearnResult learn_from_labels(cyl_colortable &t, const std::vector<std::string> 
     for (size_t i = 0; i < nc; i++) res.classes[i].r = rep[i];
 
     // Per training frame: the share each class covers; warnings.
-    for (const std::string &path : images) {
-        calib::Frame f = calib::load_frame(path);
+    for (size_t fi = 0; fi < n_images; fi++) {
+        const LabelledFrame lf = frame(fi);
+        const calib::Frame &f = lf.frame;
+        const std::string &path = f.label;
         const int w = (int)f.img.width, h = (int)f.img.height;
         std::vector<uint8_t> cls((size_t)w * h);
         check(cyl_classify(&t, &f.img, nullptr, 1, 1, cls.data(), (size_t)w), path + ": classify");
@@ -370,6 +372,21 @@ LearnResult learn_from_labels(cyl_colortable &t, const std::vector<std::string> 
                                      "' where both classes claimed the colour (the likelier class keeps it)");
     }
     return res;
+}
+
+} // namespace
+
+LearnResult learn_from_labels(cyl_colortable &t, const std::vector<std::string> &images,
+                              const std::vector<ClassSpec> &classes, const LearnOptions &o,
+                              const std::function<void(size_t, size_t)> &progress)
+{
+    return learn_core(t, images.size(), [&](size_t i) { return load_labelled(images[i], true); }, classes, o, progress);
+}
+
+LearnResult learn_from_frames(cyl_colortable &t, const std::vector<LabelledFrame> &frames,
+                              const std::vector<ClassSpec> &classes, const LearnOptions &o)
+{
+    return learn_core(t, frames.size(), [&](size_t i) { return frames[i]; }, classes, o, nullptr);
 }
 
 std::string report_text(const LearnResult &r, const cyl_colortable &t)
@@ -456,7 +473,7 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
     // centroid_inside's column
     std::string csv = "image,class,x0_px,y0_px,x1_px,y1_px,best_iou,matched_iou,centroid_inside,class_px_share\n";
     for (const std::string &path : images) {
-        Labelled l = load_labelled(path, false);
+        LabelledFrame l = load_labelled(path, false);
         const cyl_image &img = l.frame.img;
         if (img.width != cap_w || img.height != cap_h) {
             uint32_t mr = cyl_segment_max_runs(img.width, img.height, &o.detector.segment), mb = mr;
