@@ -65,12 +65,12 @@ cyl_learn_params cyl_learn_params_default(void)
 {
     cyl_learn_params p;
     p.max_bg_fraction = 0.001;
-    p.smooth_sigma_cells = 1.0;
+    p.smooth_sigma_cells = 2.0;
     p.bg_uniform_weight = 0.02;
     p.min_likelihood_ratio = 4.0;
     p.min_positive_count = 0.5;
-    p.weak_bg_fraction = 0.02;
-    p.min_weak_ratio = 1.0;
+    p.weak_bg_fraction = 0.03;
+    p.min_weak_ratio = 1.5;
     return p;
 }
 

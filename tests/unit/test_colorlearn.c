@@ -33,6 +33,7 @@ static cyl_learn_params exact_params(void)
     p.bg_uniform_weight = 0.0;
     p.min_likelihood_ratio = 1.0;
     p.min_positive_count = 0.0;
+    p.min_weak_ratio = 1.0;       /* <= min_likelihood_ratio */
     return p;
 }
 

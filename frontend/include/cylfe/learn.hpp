@@ -65,7 +65,7 @@ struct LearnOptions {
     double flood_fraction = 0.03;         // warn when a class covers more than this of a training frame
     bool weak = true;                     // give each class a weak class (hysteresis; NAME~ in the table)
     bool weak_from_top = false;           // place weak classes at the highest free indices (else lowest)
-    std::vector<double> gains{1.0};       // every training pixel counted at each of these exposure gains
+    std::vector<double> gains{0.8, 1.0, 1.25};  // every training pixel counted at each of these exposure gains
                                           // (cyl_colorhist_add_scaled: photometric augmentation)
 };
 

@@ -363,7 +363,7 @@ LearnResult learn_core(cyl_colortable &t, size_t n_images, const std::function<L
                                  "of neutral): it may fire on white, grey or black surfaces");
         if (c.worst_frame_share > o.flood_fraction)
             c.warnings.push_back("covers " + num(100 * c.worst_frame_share, 3) + "% of training frame " + c.worst_frame);
-        if (c.r.recall < 0.5)
+        if (c.r.recall < 0.15)
             c.warnings.push_back("keeps only " + num(100 * c.r.recall, 3) +
                                  "% of its labelled pixels: its colours are common in the background too");
         for (size_t j = 0; j < nc; j++)

@@ -85,7 +85,7 @@ typedef struct cyl_learn_params {
     double max_bg_fraction;      /* false-positive rate: the share of the background density a class
                                     may claim, 0..1 (default 0.001) */
     double smooth_sigma_cells;   /* Gaussian smoothing of both histograms, sigma in cells per axis
-                                    (a cell is 8 Y and 4 U/V levels), 0 = none (default 1.0) */
+                                    (a cell is 8 Y and 4 U/V levels), 0 = none (default 2.0) */
     double bg_uniform_weight;    /* weight of the uniform colour density mixed into the background
                                     model, 0..1 (default 0.02) */
     double min_likelihood_ratio; /* a cell with a smaller ratio is never claimed (default 4) */
@@ -93,11 +93,12 @@ typedef struct cyl_learn_params {
                                     pixels (default 0.5: stray single pixels claim nothing) */
     double weak_bg_fraction;     /* for classes with a weak class: the share of the background density
                                     the class and its weak class may claim together, >= max_bg_fraction
-                                    (default 0.02) */
-    double min_weak_ratio;       /* a weak cell's ratio is at least this (default 1) */
+                                    (default 0.03) */
+    double min_weak_ratio;       /* a weak cell's ratio is at least this (default 1.5) */
 } cyl_learn_params;
 
-/* The defaults above. */
+/* The defaults above: chosen on training data only (docs/colour-learning.md, "How the
+ * defaults were chosen"). */
 cyl_learn_params cyl_learn_params_default(void);
 
 /* What learning did for one class. Shares are of training pixels (raw counts,
