@@ -53,3 +53,11 @@ synth-data: $(BUILD)/cyl-render
 	$(BUILD)/cyl-render --scene default --seed 1 --write-table calib_data/synthetic.cylt -q
 	$(BUILD)/cyl-render --scene default --write-camera calib_data/synthetic_camera.yaml
 	$(BUILD)/cyl-render --scene default --write-scene calib_data/synthetic_scene.yaml
+
+# make consistency: held-out seeds 101-120 through render -> detect -> SLAM, the imaging sweep and the
+# pixel-noise-only NEES (scripts/consistency.py; about 25 minutes); make test runs its --quick form.
+consistency: $(BUILD)/cyl $(BUILD)/cyl-render $(BUILD)/cyl-synth-validate .venv/.stamp
+	@.venv/bin/python scripts/consistency.py --build $(BUILD)
+.PHONY: consistency
+TEST_EXTRA += $(BUILD)/cyl $(BUILD)/cyl-render $(BUILD)/cyl-synth-validate .venv/.stamp
+TEST_EXTRA_BINS += tests/synth/test_consistency_quick.sh:$(BUILD)

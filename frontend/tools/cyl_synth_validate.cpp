@@ -35,8 +35,9 @@ void usage(FILE *f)
         "  --frames N       frames per row of Tables 1-3 (default 400)\n"
         "  --runs N         calibration-error runs for Tables 6-7 (default 500, 3 landmarks each)\n"
         "  --conf-frames N  drive frames for the confidence check (default 600, every 3rd used)\n"
-        "  --sweep          also sweep the imaging for Tables 1-3: sensor noise x0.25 .. x4 and blur\n"
-        "                   0 .. 2 px, a colour table trained for each condition; prints every\n"
+        "  --sweep          also sweep the imaging for Tables 1-3: sensor noise x0.25 .. x4, blur\n"
+        "                   0 .. 2 px and exposure x0.6, x1.5, a colour table trained for each\n"
+        "                   condition; prints every\n"
         "                   estimator's ratio to the measured variance (how it depends on them)\n"
         "  --sweep-only     the sweep alone (implies --sweep; nothing else is run)\n"
         "  --pixel-only     only the pixel-noise-only range/bearing runs (--runs of them): the\n"
@@ -255,13 +256,14 @@ int main(int argc, char **argv)
             // Each condition: the scene's imaging changed, a colour table trained on it (as a user
             // trains on their own camera), Tables 1-3 measured; ratios estimator / measured over the
             // rows and both axes.
-            struct Cond { const char *name; double noise, blur; };
-            const Cond conds[] = {{"noise x0.25", 0.25, -1}, {"noise x0.5", 0.5, -1}, {"noise x1", 1, -1},
-                                  {"noise x2", 2, -1},       {"noise x4", 4, -1},    {"blur 0 px", 1, 0},
-                                  {"blur 0.5 px", 1, 0.5},   {"blur 2 px", 1, 2}};
+            struct Cond { const char *name; double noise, blur, exposure; };
+            const Cond conds[] = {{"noise x0.25", 0.25, -1, 1}, {"noise x0.5", 0.5, -1, 1}, {"noise x1", 1, -1, 1},
+                                  {"noise x2", 2, -1, 1},       {"noise x4", 4, -1, 1},    {"blur 0 px", 1, 0, 1},
+                                  {"blur 0.5 px", 1, 0.5, 1},   {"blur 2 px", 1, 2, 1},    {"exposure x0.6", 1, -1, 0.6},
+                                  {"exposure x1.5", 1, -1, 1.5}};
             const char *en[kEstimators] = {"uniform", "column", "local", "image"};
             double wmin[kEstimators], wmax[kEstimators];
-            int broken_all = 0;
+            int broken_all = 0, rows_all = 0;
             const double kBrokenPx2 = 1.0;
             for (int e = 0; e < kEstimators; e++) { wmin[e] = 1e30; wmax[e] = 0; }
             std::string scsv = "condition,seed,noise_y,noise_c,blur_px,label,actual_x,actual_y";
@@ -275,6 +277,7 @@ int main(int argc, char **argv)
                 s2.imaging.noise_y *= c.noise;
                 s2.imaging.noise_c *= c.noise;
                 if (c.blur >= 0) s2.imaging.blur_sigma_px = c.blur;
+                s2.imaging.exposure *= c.exposure;
                 cyl_colortable t2;
                 train_colortable(s2, &t2, seed);
                 VarianceConfig v2 = vc;
@@ -306,12 +309,14 @@ int main(int argc, char **argv)
                 }
                 std::printf("  %-12s %5.2f %5.2f %5.2f |", c.name, s2.imaging.noise_y, s2.imaging.noise_c, s2.imaging.blur_sigma_px);
                 for (int e = 0; e < kEstimators; e++) {
-                    std::printf(" %5.2f..%-6.2f", mn[e], mx[e]);
-                    wmin[e] = std::min(wmin[e], mn[e]); wmax[e] = std::max(wmax[e], mx[e]);
+                    if (mx[e] > 0) std::printf(" %5.2f..%-6.2f", mn[e], mx[e]);
+                    else std::printf(" %-13s", "  (none)");   // every row's blob broke up
+                    if (mx[e] > 0) { wmin[e] = std::min(wmin[e], mn[e]); wmax[e] = std::max(wmax[e], mx[e]); }
                 }
                 if (broken) std::printf("   %d of %zu rows: blob broke up", broken, rr.size());
                 std::printf("   [%.0f s]\n", tt.s());
                 broken_all += broken;
+                rows_all += (int)rr.size();
                 std::fflush(stdout);
             }
             std::printf("  %-30s |", "all conditions");
@@ -321,8 +326,9 @@ int main(int argc, char **argv)
             char js[600];
             snprintf(js, sizeof js, "{\"seed\":%llu,\"sweep_local_min\":%.3f,\"sweep_local_max\":%.3f,"
                      "\"sweep_image_min\":%.3f,\"sweep_image_max\":%.3f,\"sweep_uniform_min\":%.3f,\"sweep_uniform_max\":%.3f,"
-                     "\"sweep_column_min\":%.3f,\"sweep_column_max\":%.3f,\"sweep_rows_broken\":%d}",
-                     (unsigned long long)seed, wmin[2], wmax[2], wmin[3], wmax[3], wmin[0], wmax[0], wmin[1], wmax[1], broken_all);
+                     "\"sweep_column_min\":%.3f,\"sweep_column_max\":%.3f,\"sweep_rows_broken\":%d,\"sweep_rows\":%d}",
+                     (unsigned long long)seed, wmin[2], wmax[2], wmin[3], wmax[3], wmin[0], wmax[0], wmin[1], wmax[1], broken_all,
+                     rows_all);
             if (sweep_only) {
                 write_text(out + "/sweep.json", std::string(js) + "\n");
                 std::printf("%s\n", js);

@@ -193,6 +193,8 @@ class Params:
     update_every: int = 10         # iSAM2 update at least every N steps (and every observed one)
     batch: bool = True             # final batch Levenberg-Marquardt
     covariances: bool = True       # compute marginals after the batch pass
+    joint_max_dim: int = 9000      # also the joint covariance of all poses (and of all landmarks) when
+                                   # it has at most this many rows (the joint NEES, metrics.py)
     calib_states: bool = False     # estimate the calibration error (constant over the run) as a state
 
 
@@ -207,6 +209,8 @@ class Result:
     lm_ids: list                          # known identity per landmark (or None)
     assoc: list                           # (step index, Obs, landmark index) per used observation
     stats: dict = field(default_factory=dict)
+    pose_joint_cov: Optional[np.ndarray] = None  # (3N, 3N) joint covariance of all poses, or None
+    lm_joint_cov: Optional[np.ndarray] = None    # (2M, 2M) joint covariance of all landmarks, or None
 
 
 class Slam:
@@ -357,11 +361,17 @@ class Slam:
         poses = _poses(est, n)
         m = len(lms_init)
         lms = np.array([[est.atPoint2(L(j))[0], est.atPoint2(L(j))[1]] for j in range(m)]).reshape(m, 2)
-        pose_cov = lm_cov = None
+        pose_cov = lm_cov = pose_joint = lm_joint = None
         if p.covariances:
             marg = gtsam.Marginals(graph, est)
             pose_cov = np.array([marg.marginalCovariance(X(i)) for i in range(n)])
             lm_cov = np.array([marg.marginalCovariance(L(j)) for j in range(m)]).reshape(m, 2, 2)
+            # Poses share every earlier odometry step, and landmarks the poses and the calibration:
+            # their errors are correlated, and only the joint covariance whitens them together.
+            if 0 < 3 * n <= p.joint_max_dim:
+                pose_joint = marg.jointMarginalCovariance(gtsam.KeyVector([X(i) for i in range(n)])).fullMatrix()
+            if 0 < 2 * m <= p.joint_max_dim:
+                lm_joint = marg.jointMarginalCovariance(gtsam.KeyVector([L(j) for j in range(m)])).fullMatrix()
         st["t_isam_s"] = round(t_isam, 3)
         st["t_batch_s"] = round(t_batch, 3)
         st["t_total_s"] = round(time.perf_counter() - t0, 3)
@@ -371,7 +381,8 @@ class Slam:
         if use_calib:
             st["calib_error_estimate"] = [float(x) for x in est.atVector(CALIB)]
         return Result(poses=poses, pose_cov=pose_cov, isam_poses=isam_poses, lms=lms,
-                      lm_cov=lm_cov, lm_class=lm_class, lm_ids=lm_ids, assoc=assoc, stats=st)
+                      lm_cov=lm_cov, lm_class=lm_class, lm_ids=lm_ids, assoc=assoc, stats=st,
+                      pose_joint_cov=pose_joint, lm_joint_cov=lm_joint)
 
     def _associate(self, isam, i, cur, usable, covs, lms_init, lm_class, by_class, gate,
                    new_thr, st):

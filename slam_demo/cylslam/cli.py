@@ -218,7 +218,13 @@ def print_summary(s, out=sys.stdout):
         bl = s.get("anees_landmarks_bounds95") or [math.nan, math.nan]
         bp = s.get("anees_poses_bounds95") or [math.nan, math.nan]
         print(f"   ANEES landmarks {f('anees_landmarks')} (95% bounds {bl[0]:.3f}-{bl[1]:.3f}), "
-              f"poses {f('anees_poses')} ({bp[0]:.3f}-{bp[1]:.3f})", file=out)
+              f"poses {f('anees_poses')} ({bp[0]:.3f}-{bp[1]:.3f}) (means of the marginal NEES)", file=out)
+    if "anees_landmarks_joint" in s or "anees_poses_joint" in s:
+        bl = s.get("anees_landmarks_joint_bounds95") or [math.nan, math.nan]
+        bp = s.get("anees_poses_joint_bounds95") or [math.nan, math.nan]
+        print(f"   joint ANEES landmarks {f('anees_landmarks_joint')} ({bl[0]:.3f}-{bl[1]:.3f}), "
+              f"poses {f('anees_poses_joint')} ({bp[0]:.3f}-{bp[1]:.3f}) (errors whitened together: "
+              "the test for correlated estimates)", file=out)
     if "fixed_cov_failed" in s:
         print(f"   fixed covariance ({s.get('fixed_cov_tuning')}): FAILED: {s['fixed_cov_failed']}", file=out)
     elif "ate_fixed_cov_m" in s or "fixed_cov_rb" in s:
@@ -232,6 +238,7 @@ def print_summary(s, out=sys.stdout):
 
 
 LAST_KEYS = ("ate_m", "ate_unaligned_m", "landmark_rmse_m", "anees_landmarks", "anees_poses",
+             "anees_landmarks_joint", "anees_poses_joint",
              "association_errors", "ate_fixed_cov_m", "landmark_rmse_fixed_cov_m",
              "anees_landmarks_fixed_cov", "fixed_cov_failed", "ate_dead_reckoning_m")
 

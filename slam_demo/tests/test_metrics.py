@@ -65,6 +65,44 @@ def test_anees_is_one_for_a_consistent_monte_carlo():
     assert a2 == pytest.approx(4 * a)
 
 
+def test_joint_anees_known_answer():
+    # e = (1, 1), C = [[2, 1], [1, 2]]: e^T C^-1 e = 2/3, over k = 2
+    a, (lo, hi) = metrics.anees_joint([1.0, 1.0], [[2.0, 1.0], [1.0, 2.0]])
+    assert a == pytest.approx(1.0 / 3.0)
+    assert (lo, hi) == metrics.anees_bounds(2, 1)
+
+
+def test_joint_anees_holds_for_a_random_walk_where_the_marginal_mean_does_not():
+    # A consistent trajectory: x_k = x_{k-1} + w_k, w ~ N(0, q), so Cov(x_i, x_j) = q min(i, j).
+    # Over many independent trajectories both statistics average 1; per trajectory the joint one
+    # stays inside its chi-square bounds 95% of the time, the marginal mean (which assumes
+    # independent estimates) falls outside them most of the time.
+    rng = np.random.default_rng(7)
+    n, q = 300, 0.01
+    i = np.arange(1, n + 1)
+    C = q * np.minimum.outer(i, i)
+    Lc = np.linalg.cholesky(C)
+    joint_in = marg_in = 0
+    joint_vals, marg_vals = [], []
+    trials = 200
+    for _ in range(trials):
+        e = Lc @ rng.standard_normal(n)
+        a, (lo, hi) = metrics.anees_joint(e, C)
+        joint_vals.append(a)
+        joint_in += lo <= a <= hi
+        m, (mlo, mhi) = metrics.anees([np.array([x]) for x in e], [np.array([[v]]) for v in np.diag(C)])
+        marg_vals.append(m)
+        marg_in += mlo <= m <= mhi
+    assert np.mean(joint_vals) == pytest.approx(1.0, abs=0.02)
+    # the marginal mean is unbiased too, but spreads so widely (std 1.2 per trajectory here, with
+    # a heavy right tail; the joint 0.08) that 200 trajectories pin its mean only to about +-0.1
+    # (1 sigma)
+    assert np.mean(marg_vals) == pytest.approx(1.0, abs=0.35)
+    assert np.std(marg_vals) > 5 * np.std(joint_vals)
+    assert joint_in / trials > 0.9
+    assert marg_in / trials < 0.4
+
+
 def test_truth_label_follows_the_bearing_far_away():
     # Seen from the origin: landmark 2 at 6.18 m, landmark 4 at 3.07 m, 0.16 rad apart. A far
     # observation of landmark 2 whose range came out 1.63 m short (2.7 sigma, sigma_r 0.61 m)

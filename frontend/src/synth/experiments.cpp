@@ -179,7 +179,7 @@ std::vector<VarianceRow> run_variance_tables(const Scene &base, const cyl_colort
             b.size_z_m = zc - (zc - zt) * d / r;
             sc.boxes.push_back(b);
         }
-        ren.render_clean(robot, 1.0, clean);
+        ren.render_clean(robot, ren.scene().imaging.exposure, clean);   // exposure: 1 in the scenes, varied by the sweep
         VarianceRow row;
         char lab[64];
         snprintf(lab, sizeof lab, "%s%.1f m", occ ? "occluded " : "", r);

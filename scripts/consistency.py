@@ -1,0 +1,192 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
+"""make consistency: is the uncertainty libcyl reports consistent on runs no choice has seen?
+
+Choices (thresholds, gates, noise scales) were made on seeds 1-20; this evaluates on seeds 101-120.
+For each seed: cyl-render (a drive with a calibration error drawn once) -> cyl detect -> cylslam run
+(per-observation covariance with the calibration as a state, beside the best fixed covariance that
+maps), and it prints the landmark and pose ANEES with their 95% chi-square bounds -- the joint ANEES
+(errors whitened together with the joint covariance: chi-square however correlated the estimates
+are, the figure judged) and the mean of the marginal NEES (which assumes independent estimates and
+is shown for comparison) --, ATE against the
+best fixed covariance and dead reckoning, and association errors. Then the imaging sweep (sensor
+noise x0.25-x4, blur 0-2 px, exposure x0.6 and x1.5: each estimator's centroid variance over the
+measured one, cyl-synth-validate --sweep-only) and the pixel-noise-only NEES. Writes a plot of the
+ANEES per seed with its bounds. The last line is one JSON object.
+
+Usage: scripts/consistency.py [--quick] [--seeds 101-120] [--frames N] [--out DIR] [--build DIR]
+  --quick  seeds 101-102 at 300 frames and the sweep's reduced sizes (what make test runs)
+Exit codes: 0 ran (whatever the figures), 1 a tool failed, 2 bad command line.
+"""
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+import time
+
+
+def run(cmd, env=None):
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    if p.returncode != 0:
+        sys.stderr.write(" ".join(cmd) + f" failed (exit {p.returncode}):\n" + p.stderr[-2000:])
+        sys.exit(1)
+    return p.stdout
+
+
+def seeds_arg(s):
+    out = []
+    for part in s.split(","):
+        m = re.fullmatch(r"(\d+)(?:-(\d+))?", part.strip())
+        if not m:
+            raise argparse.ArgumentTypeError(f"seeds: expected e.g. 101-120 or 101,105, got '{s}'")
+        a, b = int(m.group(1)), int(m.group(2) or m.group(1))
+        out += list(range(a, b + 1))
+    return out
+
+
+def drive(build, out, seed, frames, python):
+    d = os.path.join(out, f"seed{seed}")
+    os.makedirs(d, exist_ok=True)
+    raw, obs = os.path.join(d, "drive.cylraw"), os.path.join(d, "observations.jsonl")
+    run([os.path.join(build, "cyl-render"), "-o", raw, "-n", str(frames), "-s", str(seed), "--calib-error", "-q"])
+    run([os.path.join(build, "cyl"), "detect", raw, "--table", "calib_data/synthetic.cylt", "--calib",
+         "calib_data/synthetic_camera.yaml", "--size", "orange=0.10,0.30", "--size", "green=0.10,0.30",
+         "--out", obs, "--quiet"])
+    os.remove(raw)
+    env = dict(os.environ, PYTHONPATH="slam_demo")
+    run([python, "-m", "cylslam", "run", obs, "--out", os.path.join(d, "slam"), "--calib-states", "--no-plot",
+         "--no-progress"], env=env)
+    with open(os.path.join(d, "slam", "summary.json")) as f:
+        return json.load(f)
+
+
+def inside(v, b):
+    return v is not None and b is not None and b[0] <= v <= b[1]
+
+
+def plot(path, rows):
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return False
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    for ax, key, title in ((axes[0], "landmarks", "landmark ANEES"), (axes[1], "poses", "pose ANEES")):
+        xs = list(range(len(rows)))
+        for i, r in enumerate(rows):
+            lo, hi = r[f"anees_{key}_bounds95"] or (None, None)
+            if lo is not None:
+                ax.plot([i, i], [lo, hi], color="0.6", lw=6, alpha=0.5, solid_capstyle="butt")
+            v = r[f"anees_{key}"]
+            if v is not None:
+                ok = inside(v, r[f"anees_{key}_bounds95"])
+                ax.plot(i, v, "o", color="tab:green" if ok else "tab:red")
+        ax.set_xticks(xs)
+        ax.set_xticklabels([str(r["seed"]) for r in rows], rotation=90, fontsize=7)
+        ax.set_yscale("log")
+        ax.set_xlabel("seed (held out)")
+        ax.set_title("joint " + title + " (grey: 95% bounds; green inside)", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    return True
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--seeds", type=seeds_arg, default=None)
+    ap.add_argument("--frames", type=int, default=None)
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--python", default=".venv/bin/python")
+    a = ap.parse_args()
+    seeds = a.seeds or ([101, 102] if a.quick else list(range(101, 121)))
+    frames = a.frames or (300 if a.quick else 1000)
+    out = a.out or os.path.join(a.build, "consistency" + ("-quick" if a.quick else ""))
+    os.makedirs(out, exist_ok=True)
+    t0 = time.time()
+    rows = []
+    print("joint ANEES (judged) and the mean of the marginal NEES (marg.)")
+    print(f"{'seed':>5} {'lm ANEES':>9} {'(marg.)':>8} {'bounds':>11} {'pose ANEES':>10} {'(marg.)':>8} {'bounds':>11} "
+          f"{'ATE m':>8} {'fixed m':>8} {'dead-r m':>8} {'assoc':>5} {'mapped':>7}")
+    for i, seed in enumerate(seeds):
+        s = drive(a.build, out, seed, frames, a.python)
+        r = {"seed": seed, "anees_landmarks": s.get("anees_landmarks_joint"),
+             "anees_landmarks_bounds95": s.get("anees_landmarks_joint_bounds95"),
+             "anees_poses": s.get("anees_poses_joint"), "anees_poses_bounds95": s.get("anees_poses_joint_bounds95"),
+             "anees_landmarks_marginal": s.get("anees_landmarks"),
+             "anees_landmarks_marginal_bounds95": s.get("anees_landmarks_bounds95"),
+             "anees_poses_marginal": s.get("anees_poses"), "anees_poses_marginal_bounds95": s.get("anees_poses_bounds95"),
+             "ate_m": s.get("ate_m"), "ate_fixed_cov_m": s.get("ate_fixed_cov_m"),
+             "ate_dead_reckoning_m": s.get("ate_dead_reckoning_m"), "association_errors": s.get("association_errors", 0),
+             "landmarks_matched": s.get("landmarks_matched"), "landmarks_true": s.get("landmarks_true"),
+             "fixed_cov_failed": s.get("fixed_cov_failed")}
+        rows.append(r)
+
+        def f(v, w=8, p=4):
+            return f"{v:{w}.{p}f}" if isinstance(v, (int, float)) else f"{'-':>{w}}"
+
+        def b(x):
+            return f"{x[0]:.2f}-{x[1]:.2f}" if x else "-"
+        print(f"{seed:>5} {f(r['anees_landmarks'], 9, 3)} {f(r['anees_landmarks_marginal'], 8, 3)} "
+              f"{b(r['anees_landmarks_bounds95']):>11} {f(r['anees_poses'], 10, 3)} {f(r['anees_poses_marginal'], 8, 3)} "
+              f"{b(r['anees_poses_bounds95']):>11} {f(r['ate_m'])} {f(r['ate_fixed_cov_m'])} "
+              f"{f(r['ate_dead_reckoning_m'])} {r['association_errors']:>5} "
+              f"{r['landmarks_matched']}/{r['landmarks_true']}   [{time.time() - t0:.0f} s, {i + 1}/{len(seeds)}]", flush=True)
+    n = len(rows)
+    lm_in = sum(inside(r["anees_landmarks"], r["anees_landmarks_bounds95"]) for r in rows)
+    pose_in = sum(inside(r["anees_poses"], r["anees_poses_bounds95"]) for r in rows)
+    better = sum(1 for r in rows if r["ate_m"] is not None and r["ate_fixed_cov_m"] is not None
+                 and r["ate_m"] < r["ate_fixed_cov_m"])
+    lm_in_m = sum(inside(r["anees_landmarks_marginal"], r["anees_landmarks_marginal_bounds95"]) for r in rows)
+    pose_in_m = sum(inside(r["anees_poses_marginal"], r["anees_poses_marginal_bounds95"]) for r in rows)
+    print(f"joint ANEES inside the bounds: landmarks on {lm_in} of {n} seeds, poses on {pose_in} of {n} "
+          f"(marginal means: {lm_in_m} and {pose_in_m}); ATE better than the best fixed covariance on {better} of {n}")
+
+    print("\n== imaging sweep (cyl-synth-validate --sweep-only, seed 101): estimator / measured centroid variance")
+    sw_args = [os.path.join(a.build, "cyl-synth-validate"), "--sweep-only", "--seed", "101", "--out", os.path.join(out, "sweep")]
+    if a.quick:
+        sw_args.append("--quick")
+    sw = run(sw_args)
+    lines = sw.strip().splitlines()
+    start = next((i for i, l in enumerate(lines) if l.startswith("Imaging sweep")), 0)
+    print("\n".join(lines[start:-1]))
+    sweep = json.loads(lines[-1])
+
+    print("\n== pixel-noise-only NEES (cyl-synth-validate --pixel-only, seed 101)")
+    px = [os.path.join(a.build, "cyl-synth-validate"), "--pixel-only", "--seed", "101", "--out", os.path.join(out, "pixel")]
+    if a.quick:
+        px += ["--runs", "150"]
+    pxo = run(px).strip().splitlines()
+    pj = json.loads(pxo[-1])
+    print(f"   mean NEES {pj.get('pixel_only_mean_nees')} over {pj.get('n', '?')} observations (2 expected)")
+
+    plotted = plot(os.path.join(out, "anees.png"), rows)
+    print(f"\noutputs in {out}/: seed*/ (observation logs and SLAM summaries), sweep/, pixel/"
+          + (", anees.png" if plotted else "") + f"   [{time.time() - t0:.0f} s]")
+    res = {
+        "seeds": seeds, "frames": frames,
+        "seeds_landmark_anees_in_bounds": round(lm_in / n, 3),
+        "seeds_pose_anees_in_bounds": round(pose_in / n, 3),
+        "seeds_landmark_anees_marginal_in_bounds": round(lm_in_m / n, 3),
+        "seeds_pose_anees_marginal_in_bounds": round(pose_in_m / n, 3),
+        "association_errors_total": sum(r["association_errors"] or 0 for r in rows),
+        "ate_better_than_fixed_frac": round(better / n, 3),
+        "estimator_ratio_min": sweep.get("sweep_image_min"), "estimator_ratio_max": sweep.get("sweep_image_max"),
+        "sweep_rows_broken": sweep.get("sweep_rows_broken"), "sweep_rows": sweep.get("sweep_rows"),
+        "pixel_only_nees": pj.get("pixel_only_mean_nees"),
+        "anees_landmarks": [r["anees_landmarks"] for r in rows], "anees_poses": [r["anees_poses"] for r in rows],
+        "anees_landmarks_marginal": [r["anees_landmarks_marginal"] for r in rows],
+        "anees_poses_marginal": [r["anees_poses_marginal"] for r in rows],
+    }
+    with open(os.path.join(out, "consistency.json"), "w") as f:
+        json.dump({"result": res, "rows": rows}, f, indent=1)
+    print(json.dumps(res))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
+# make consistency's reduced form (scripts/consistency.py --quick: held-out seeds 101-102 at 300
+# frames, the imaging sweep at reduced sizes, the pixel-noise-only NEES). Asserts what holds today
+# and would catch a regression: no association error, the pixel-only NEES within 1.6-2.6 (2
+# expected, no floor), the image estimator's ratio to the measured variance within 0.5-1.5 over
+# the sweep, every seed's SLAM run producing both ANEES figures with their bounds. The full
+# figures (20 seeds) are make consistency's. GoogleTest-style lines.
+#   test_consistency_quick.sh BUILD_DIR
+set -u
+B=$1
+cd "$(dirname "$0")/../.."
+T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
+echo "[ RUN      ] consistency.quick"
+if ! .venv/bin/python scripts/consistency.py --quick --build "$B" --out "$T/c" >"$T/log" 2>"$T/err"; then
+  echo "  consistency.py failed: $(tail -5 "$T/err")"; echo "[  FAILED  ] consistency.quick"; exit 1
+fi
+msg=$(.venv/bin/python - "$T/log" "$T/c/consistency.json" <<'PY'
+import json, sys
+r = json.loads(open(sys.argv[1]).read().strip().splitlines()[-1])
+rows = json.load(open(sys.argv[2]))["rows"]
+bad = []
+if r["association_errors_total"] != 0: bad.append(f"association errors {r['association_errors_total']}")
+if not 1.6 <= r["pixel_only_nees"] <= 2.6: bad.append(f"pixel-only NEES {r['pixel_only_nees']}")
+if not (0.5 <= r["estimator_ratio_min"] and r["estimator_ratio_max"] <= 1.5):
+    bad.append(f"image estimator ratio {r['estimator_ratio_min']}..{r['estimator_ratio_max']}")
+for row in rows:
+    for k in ("anees_landmarks", "anees_poses"):
+        if not (isinstance(row[k], float) and row[k] > 0 and row[k + "_bounds95"]):
+            bad.append(f"seed {row['seed']}: no {k}")
+for k in ("seeds_landmark_anees_in_bounds", "seeds_pose_anees_in_bounds", "ate_better_than_fixed_frac"):
+    if not 0 <= r[k] <= 1: bad.append(f"{k} {r[k]}")
+print("; ".join(bad))
+PY
+)
+if [ -z "$msg" ]; then echo "[       OK ] consistency.quick ($(tail -1 "$T/log" | cut -c1-200))"; echo "[  PASSED  ] 1 tests."
+else echo "  $msg"; echo "[  FAILED  ] consistency.quick"; exit 1; fi
