@@ -45,3 +45,11 @@ victoria: $(VENV)/.stamp
 slam-run: $(VENV)/.stamp
 	@test -n "$(LOG)" || { echo "usage: make slam-run LOG=FILE.jsonl [SLAM_ARGS=...]"; exit 2; }
 	$(CYLSLAM) run $(LOG) --out $(SLAM_OUT)/$(basename $(notdir $(LOG))) $(SLAM_ARGS)
+
+# the Python binding of the core (python/cyl, cffi): built in place and tested in make test;
+# make pip-check installs the repository into a fresh venv the way a newcomer does (needs PyPI)
+TEST_EXTRA += $(BUILD)/cyl $(BUILD)/cyl-render
+TEST_EXTRA_BINS += pytest:python/run_tests.sh
+pip-check:
+	@scripts/pip-check.sh
+.PHONY: pip-check

@@ -123,53 +123,16 @@ def calib_prior(cov):
 
 
 def hungarian(cost):
-    """Minimum-cost assignment of rows to distinct columns (rows <= cols). Returns col per row."""
+    """Minimum-cost assignment of rows to distinct columns (rows <= cols). Returns col per row.
+    SciPy's linear_sum_assignment (the Jonker-Volgenant algorithm)."""
+    from scipy.optimize import linear_sum_assignment
     cost = np.asarray(cost, float)
     n, m = cost.shape
     assert n <= m
-    INF = float("inf")
-    u = [0.0] * (n + 1)
-    v = [0.0] * (m + 1)
-    p = [0] * (m + 1)
-    way = [0] * (m + 1)
-    for i in range(1, n + 1):
-        p[0] = i
-        j0 = 0
-        minv = [INF] * (m + 1)
-        used = [False] * (m + 1)
-        while True:
-            used[j0] = True
-            i0 = p[j0]
-            delta = INF
-            j1 = -1
-            for j in range(1, m + 1):
-                if not used[j]:
-                    cur = cost[i0 - 1, j - 1] - u[i0] - v[j]
-                    if cur < minv[j]:
-                        minv[j] = cur
-                        way[j] = j0
-                    if minv[j] < delta:
-                        delta = minv[j]
-                        j1 = j
-            for j in range(m + 1):
-                if used[j]:
-                    u[p[j]] += delta
-                    v[j] -= delta
-                else:
-                    minv[j] -= delta
-            j0 = j1
-            if p[j0] == 0:
-                break
-        while True:
-            j1 = way[j0]
-            p[j0] = p[j1]
-            j0 = j1
-            if j0 == 0:
-                break
+    rows, cols = linear_sum_assignment(cost)
     ans = [-1] * n
-    for j in range(1, m + 1):
-        if p[j]:
-            ans[p[j] - 1] = j - 1
+    for r, c in zip(rows, cols):
+        ans[int(r)] = int(c)
     return ans
 
 
