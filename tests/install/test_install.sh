@@ -16,7 +16,8 @@ msg=""
 # in the environment too; a sanitized library cannot link into a plain program)
 env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL -u SAN make -s install SAN= PREFIX="$T/prefix" >"$T/log" 2>&1 ||
   msg="make install failed: $(tail -5 "$T/log")"
-for f in include/cyl/version.h include/cyl/silhouette.h lib/libcyl.a lib/pkgconfig/libcyl.pc; do
+for f in include/cyl/version.h include/cyl/colorlearn.h lib/libcyl.a lib/libcyl.so lib/pkgconfig/libcyl.pc \
+         lib/cmake/cyl/cylConfig.cmake lib/cmake/cyl/cylConfigVersion.cmake; do
   [ -f "$T/prefix/$f" ] || msg="$msg; $f not installed"
 done
 result prefix "$msg"
@@ -31,10 +32,30 @@ hv=$(sed -n 's/^#define CYL_VERSION_STRING "\(.*\)"/\1/p' libcyl/include/cyl/ver
 cc -std=c99 -Wall -Wextra -Werror tests/install/consumer.c -o "$T/consumer" $(pkg-config --cflags --libs libcyl) \
   >"$T/cc" 2>&1 || msg="$msg; the consumer does not build with pkg-config alone: $(head -c 400 "$T/cc")"
 if [ -x "$T/consumer" ]; then
-  out=$("$T/consumer") || msg="$msg; the consumer failed (exit $?)"
+  # pkg-config's -lcyl picks the shared library: the loader finds it through LD_LIBRARY_PATH
+  out=$(LD_LIBRARY_PATH="$T/prefix/lib" "$T/consumer") || msg="$msg; the consumer failed (exit $?)"
   echo "$out" | grep -q "^libcyl $hv: blob area 100 at (24.5, 14.5)" || msg="$msg; unexpected output: $out"
+  ldd "$T/consumer" | grep -q "libcyl.so.${hv%%.*} => $T/prefix/lib/" 2>/dev/null ||
+    LD_LIBRARY_PATH="$T/prefix/lib" ldd "$T/consumer" | grep -q "libcyl.so.${hv%%.*} => $T/prefix/lib/" ||
+    msg="$msg; not linked against the installed libcyl.so: $(LD_LIBRARY_PATH="$T/prefix/lib" ldd "$T/consumer" | grep cyl)"
 fi
 result pkg_config_consumer "$msg"
+
+echo "[ RUN      ] install.cmake_consumer"
+msg=""
+if ! cmake -S tests/install -B "$T/cm" -DCMAKE_PREFIX_PATH="$T/prefix" >"$T/cmake.log" 2>&1 ||
+   ! cmake --build "$T/cm" >>"$T/cmake.log" 2>&1; then
+  msg="find_package(cyl) build failed: $(tail -8 "$T/cmake.log")"
+else
+  for v in shared static; do
+    out=$("$T/cm/consumer_$v") || msg="$msg; consumer_$v failed (exit $?)"
+    echo "$out" | grep -q "^libcyl $hv: blob area 100 at (24.5, 14.5)" || msg="$msg; consumer_$v: $out"
+  done
+  # CMake puts the imported library's folder in the shared consumer's RUNPATH; the static one has no libcyl.so
+  ldd "$T/cm/consumer_shared" | grep -q "libcyl.so" || msg="$msg; consumer_shared does not use libcyl.so"
+  ldd "$T/cm/consumer_static" | grep -q "libcyl.so" && msg="$msg; consumer_static uses libcyl.so"
+fi
+result cmake_consumer "$msg"
 
 echo "[==========] $((passed + failed)) tests ran."
 echo "[  PASSED  ] $passed tests."
