@@ -40,6 +40,8 @@ void usage(FILE *f)
         "                   condition; prints every\n"
         "                   estimator's ratio to the measured variance (how it depends on them)\n"
         "  --sweep-only     the sweep alone (implies --sweep; nothing else is run)\n"
+        "  --sweep-frames N frames per row of the sweep (default 150, at most --frames; the measured\n"
+        "                   variance of N frames is itself uncertain by sqrt(2/(N-1)), 12%% at 150)\n"
         "  --pixel-only     only the pixel-noise-only range/bearing runs (--runs of them): the\n"
         "                   centroid's bias against the landmark centre and the range/bearing NEES;\n"
         "                   writes pixel_only.csv\n"
@@ -180,7 +182,7 @@ int main(int argc, char **argv)
 {
     if (cylfe::print_version_if_asked(argc, argv, "cyl-synth-validate")) return 0;
     std::string out = "build/validate", scene_name = "default";
-    unsigned frames = 400, runs = 500, conf_frames = 600;
+    unsigned frames = 400, runs = 500, conf_frames = 600, sweep_frames = 150;
     bool sweep = false, sweep_only = false, pixel_only = false;
     uint64_t seed = 1;
     bool seed_given = false;
@@ -199,6 +201,7 @@ int main(int argc, char **argv)
         else if (a == "--frames") frames = num();
         else if (a == "--runs") runs = num();
         else if (a == "--conf-frames") conf_frames = num();
+        else if (a == "--sweep-frames") sweep_frames = num();
         else if (a == "--sweep") sweep = true;
         else if (a == "--sweep-only") sweep = sweep_only = true;
         else if (a == "--pixel-only") pixel_only = true;
@@ -281,7 +284,7 @@ int main(int argc, char **argv)
                 cyl_colortable t2;
                 train_colortable(s2, &t2, seed);
                 VarianceConfig v2 = vc;
-                v2.frames = std::min(frames, 150u);
+                v2.frames = std::min(frames, sweep_frames);
                 auto rr = run_variance_tables(s2, t2, v2);
                 double mn[kEstimators], mx[kEstimators];
                 int broken = 0;
