@@ -44,6 +44,8 @@ const char *kUsage =
     "  --min-ratio R       never claim a colour less than R times likelier in the class (default 4)\n"
     "  --weak-fpr F        share of background the class and its weak class NAME~ may claim together\n"
     "                      (default 0.03); weak pixels count only where they touch the class's own\n"
+    "  --min-share S       each class keeps at least S of its boxes' pixels, the threshold lowered\n"
+    "                      below the rate's if need be (default 0: the rate alone)\n"
     "  --unseen W          weight of a uniform colour density in the background model: how likely a\n"
     "                      colour never seen in training is background (default 0.02)\n"
     "  --min-weak-ratio R  never give the weak class a colour less than R times likelier in the class\n"
@@ -503,6 +505,7 @@ int learn_main(int argc, char **argv)
                 }
             }
             else if (s == "--weak-fpr") lo.params.weak_bg_fraction = parse_num(s, next(), 0, 1, false);
+            else if (s == "--min-share") lo.params.min_class_share = parse_num(s, next(), 0, 1, false);
             else if (s == "--unseen") lo.params.bg_uniform_weight = parse_num(s, next(), 0, 1, false);
             else if (s == "--min-weak-ratio") lo.params.min_weak_ratio = parse_num(s, next(), 0, 1e9, false);
             else if (s == "--class") {

@@ -71,6 +71,7 @@ cyl_learn_params cyl_learn_params_default(void)
     p.min_positive_count = 0.5;
     p.weak_bg_fraction = 0.03;
     p.min_weak_ratio = 1.5;
+    p.min_class_share = 0.0;
     return p;
 }
 
@@ -162,6 +163,16 @@ static float rate_threshold(const float *L, const float *bg, double floor_ratio,
     return thr;
 }
 
+/* Share of a class's (raw) training pixels in the cells with ratio > thr. */
+static double class_share(const float *L, const cyl_colorhist *pos, float thr)
+{
+    uint64_t k = 0;
+    unsigned c;
+    for (c = 0; c < K; c++)
+        if (L[c] > thr) k += pos->count[c];
+    return (double)k / (double)pos->total;
+}
+
 static void set_cells(cyl_colortable *t, unsigned cls, const float *L, float lo, float hi)
 {
     const cyl_mask bit = (cyl_mask)(1u << cls);
@@ -201,7 +212,8 @@ cyl_status cyl_colortable_learn(cyl_colortable *t, const cyl_learn_class *classe
         !(p.min_likelihood_ratio >= 0.0 && p.min_likelihood_ratio < 1e30) ||
         !(p.min_positive_count >= 0.0 && p.min_positive_count < 1e30) ||
         !(p.weak_bg_fraction >= p.max_bg_fraction && p.weak_bg_fraction <= 1.0) ||
-        !(p.min_weak_ratio >= 0.0 && p.min_weak_ratio <= p.min_likelihood_ratio))
+        !(p.min_weak_ratio >= 0.0 && p.min_weak_ratio <= p.min_likelihood_ratio) ||
+        !(p.min_class_share >= 0.0 && p.min_class_share <= 1.0))
         return CYL_ERR_ARG;
     for (i = 0; i < n; i++) {
         const cyl_learn_class *k = &classes[i];
@@ -260,6 +272,21 @@ cyl_status cyl_colortable_learn(cyl_colortable *t, const cyl_learn_class *classe
         }
         if (maxlr <= 0.0) return CYL_ERR_EMPTY;
         thr[i] = rate_threshold(L, bg, p.min_likelihood_ratio, maxlr, p.max_bg_fraction);
+        if (p.min_class_share > 0.0 && class_share(L, pos, thr[i]) < p.min_class_share) {
+            /* lower the threshold (bisection in log space) until the class keeps its share */
+            double lo = log(p.min_likelihood_ratio > 1e-30 ? p.min_likelihood_ratio : 1e-30), hi = log((double)thr[i]);
+            int it;
+            if (class_share(L, pos, (float)exp(lo)) < p.min_class_share) {
+                thr[i] = (float)(exp(lo) * (1.0 - 1e-6));
+            } else {
+                for (it = 0; it < 60; it++) {
+                    double mid = 0.5 * (lo + hi);
+                    if (class_share(L, pos, (float)exp(mid)) >= p.min_class_share) lo = mid;
+                    else hi = mid;
+                }
+                thr[i] = (float)exp(lo);
+            }
+        }
         wthr[i] = classes[i].weak_cls != CYL_CLASS_NONE
                       ? rate_threshold(L, bg, p.min_weak_ratio, maxlr, p.weak_bg_fraction) : thr[i];
         if (wthr[i] > thr[i]) wthr[i] = thr[i];

@@ -133,6 +133,17 @@ static void test_rate_decides_hand_derived(void **state)
     assert_true(r.lr_threshold < 100.0);
     assert_int_equal(cyl_colortable_mask(t, 120, 90, 90), 1u << 2);
 
+    /* a minimum share of the class's pixels lowers the threshold below the rate's: with 0.95,
+     * a alone (0.9) is not enough, c joins at the cost of 0.001 of the background */
+    p.max_bg_fraction = 0.0005;
+    p.min_class_share = 0.95;
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(r.cells, 2);
+    assert_float_equal(r.recall, 1.0, 1e-12);
+    assert_float_equal(r.bg_fraction, 0.001, 1e-12);
+    p.min_class_share = 0.0;
+    p.max_bg_fraction = 0.002;
+
     p.min_likelihood_ratio = 150;  /* ... unless its ratio (100) is below the floor */
     assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_OK);
     assert_int_equal(r.cells, 1);

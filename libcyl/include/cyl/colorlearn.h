@@ -95,6 +95,9 @@ typedef struct cyl_learn_params {
                                     the class and its weak class may claim together, >= max_bg_fraction
                                     (default 0.03) */
     double min_weak_ratio;       /* a weak cell's ratio is at least this (default 1.5) */
+    double min_class_share;      /* the class keeps at least this share of its own training pixels,
+                                    the threshold lowered below the rate's if need be (never under
+                                    min_likelihood_ratio); 0..1 (default 0: the rate alone) */
 } cyl_learn_params;
 
 /* The defaults above: chosen on training data only (docs/colour-learning.md, "How the
