@@ -34,12 +34,19 @@ struct Reader {
             if (!it->first.IsScalar()) fail(it->first, where + ": a key that is not a plain name");
             const std::string k = it->first.Scalar();
             const int line = it->first.Mark().line + 1;
-            if (seen.count(k))
-                fail(it->first, where + ": key '" + k + "' given twice (lines " + std::to_string(seen[k]) + " and " +
-                                    std::to_string(line) + ")");
+            if (seen.count(k)) {
+                std::string msg = where;
+                msg += ": key '" + k + "' given twice (lines " + std::to_string(seen[k]) + " and ";
+                msg += std::to_string(line) + ")";
+                fail(it->first, msg);
+            }
             seen[k] = line;
-            if (!known.empty() && std::find(known.begin(), known.end(), k) == known.end())
-                fail(it->first, where + ": unknown key '" + k + "'" + did_you_mean(k, known));
+            if (!known.empty() && std::find(known.begin(), known.end(), k) == known.end()) {
+                std::string msg = where;
+                msg += ": unknown key '" + k + "'";
+                msg += did_you_mean(k, known);
+                fail(it->first, msg);
+            }
         }
     }
 

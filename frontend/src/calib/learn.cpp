@@ -158,7 +158,7 @@ std::vector<std::string> expand_images(const std::vector<std::string> &args)
             if (!d) throw Error(a + ": cannot read directory: " + std::strerror(errno));
             while (struct dirent *e = ::readdir(d.get())) {
                 std::string n = e->d_name;
-                if (n[0] != '.' && is_image_ext(ext_of(n))) files.push_back(a + "/" + n);
+                if (n[0] != '.' && is_image_ext(ext_of(n))) files.push_back(std::string(a).append("/").append(n));
             }
             std::sort(files.begin(), files.end());
             if (files.empty()) throw Error(a + ": no image files (jpg, jpeg, png, bmp) in this directory");
@@ -172,7 +172,7 @@ std::vector<std::string> expand_images(const std::vector<std::string> &args)
             while (std::getline(f, line)) {
                 if (!line.empty() && line.back() == '\r') line.pop_back();
                 if (line.empty() || line[0] == '#') continue;
-                out.push_back(line[0] == '/' ? line : dir + "/" + line);
+                out.push_back(line[0] == '/' ? line : std::string(dir).append("/").append(line));
             }
         } else {
             out.push_back(a);
@@ -594,7 +594,7 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
         if (!vis.empty()) {
             size_t slash = path.find_last_of('/'), dot = path.find_last_of('.');
             std::string stem = path.substr(slash == std::string::npos ? 0 : slash + 1);
-            if (dot != std::string::npos && dot > (slash == std::string::npos ? 0 : slash)) stem = stem.substr(0, stem.find_last_of('.'));
+            if (dot != std::string::npos && dot > (slash == std::string::npos ? 0 : slash)) stem.resize(stem.find_last_of('.'));
             const std::string out = o.overlay_dir + "/" + stem + ".png";
             if (!cv::imwrite(out, vis)) throw Error(out + ": cannot write overlay image");
         }
