@@ -7,12 +7,23 @@ FRONTEND_HDRS := $(wildcard frontend/include/cylfe/*.hpp)
 CV_FLAGS = $(shell pkg-config --cflags opencv4 2>/dev/null)
 # what the frontend links: OpenCV, and yaml-cpp for calibration files (frontend/src/calibration.cpp)
 CV_LIBS = $(shell pkg-config --libs opencv4 2>/dev/null) -lyaml-cpp
+# what `cyl` links: OpenCV's core and imgproc only. Image and video files and windows go through
+# the plugin libcyl-media.so (frontend/include/cylfe/media.hpp), loaded when first used, so the
+# robot's case (camera or raw log in, observations out) loads no codec, video or GUI stack.
+CV_LIBS_CORE = -lopencv_imgproc -lopencv_core -lyaml-cpp
+MEDIA_SO := $(BUILD)/libcyl-media.so
+MEDIA_LIBS = -lopencv_highgui -lopencv_videoio -lopencv_imgcodecs -lopencv_core
+
+$(MEDIA_SO): frontend/src/media_plugin/media_plugin.cpp frontend/include/cylfe/media.hpp | $(STAMP)/debs-cv
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) -fPIC -shared -fvisibility=hidden $< -o $@ $(MEDIA_LIBS)
 
 $(BUILD)/frontend/%.o: frontend/src/%.cpp $(FRONTEND_HDRS) $(wildcard libcyl/include/cyl/*.h) | $(STAMP)/debs-cv
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) -c $< -o $@
 
-$(FRONTEND_A): $(FRONTEND_OBJS)
+# every program on the frontend finds the media plugin beside it (or one folder up, for tests)
+$(FRONTEND_A): $(FRONTEND_OBJS) | $(MEDIA_SO)
 	rm -f $@.tmp && ar rcs $@.tmp $^ && mv $@.tmp $@
 
 # ---- V4L2 against the kernel's vivid driver, under qemu (part of make test) --------------
@@ -41,7 +52,7 @@ $(BUILD)/frontend/synth/%.o: frontend/src/synth/%.cpp $(wildcard frontend/src/sy
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) -c $< -o $@
 $(BUILD)/cyl: frontend/tools/cyl.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
-	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) $< -o $@ $(FRONTEND_A) $(FE_SYNTH_OBJS) $(LIBCYL_A) $(CV_LIBS) -lm
+	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) $< -o $@ $(FRONTEND_A) $(FE_SYNTH_OBJS) $(LIBCYL_A) $(CV_LIBS_CORE) -lm
 tools: $(BUILD)/cyl
 .PHONY: tools
 

@@ -8,7 +8,9 @@
 #include <fstream>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // cv::IMREAD_* only: the reading is in the media plugin
+
+#include "cylfe/media.hpp"
 #include <yaml-cpp/yaml.h>
 
 #include "cylfe/keys.hpp"
@@ -125,7 +127,7 @@ bool blob_passes(const DetectorConfig &cfg, const cyl_blob &b, uint32_t frame_wi
 
 void load_detector_mask(const std::string &path, DetectorConfig &cfg)
 {
-    cv::Mat m = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    cv::Mat m = media::imread(path, cv::IMREAD_GRAYSCALE);
     if (m.empty()) throw Error(path + ": cannot read the mask image");
     cfg.mask.assign(m.total(), 0);
     for (int y = 0; y < m.rows; y++)
@@ -318,5 +320,7 @@ void ObservationLog::close()
     if (bad) throw Error(part_ + ": write failed: " + std::strerror(errno));
     finish_output(plan_);
 }
+
+std::string json_quote(const std::string &s) { return str(s); }
 
 } // namespace cylfe

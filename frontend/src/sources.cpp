@@ -7,7 +7,9 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
+#include <opencv2/videoio.hpp>  // cv::CAP_PROP_* only: reading is in the media plugin
+
+#include "cylfe/media.hpp"
 
 namespace cylfe {
 
@@ -65,7 +67,7 @@ bool RawLogSource::next(SourceEvent &ev)
 struct FileSource::Impl {
     std::vector<std::string> paths;
     size_t next_path = 0;
-    cv::VideoCapture video;
+    media::VideoReader video;
     bool is_video = false;
     double frames_total = 0, frames_done = 0, fps = 30;
     cv::Mat bgr, yuv;
@@ -92,7 +94,7 @@ FileSource::FileSource(const std::vector<std::string> &paths, double fps) : impl
         if (f > 0) impl_->fps = f;
         if (!impl_->video.read(impl_->bgr) || impl_->bgr.empty()) throw Error(paths[0] + ": no frame in video");
     } else {
-        impl_->bgr = cv::imread(paths[0], cv::IMREAD_COLOR);
+        impl_->bgr = media::imread(paths[0], cv::IMREAD_COLOR);
         if (impl_->bgr.empty()) throw Error(paths[0] + ": cannot read image");
         impl_->frames_total = (double)paths.size();
     }
@@ -121,7 +123,7 @@ bool FileSource::next(SourceEvent &ev)
     } else {
         if (m.next_path >= m.paths.size()) return false;
         if (m.next_path > 0) {
-            m.bgr = cv::imread(m.paths[m.next_path], cv::IMREAD_COLOR);
+            m.bgr = media::imread(m.paths[m.next_path], cv::IMREAD_COLOR);
             if (m.bgr.empty()) throw Error(m.paths[m.next_path] + ": cannot read image");
         }
         m.next_path++;

@@ -20,7 +20,7 @@
 #include <string>
 #include <sys/stat.h>
 
-#include <opencv2/imgcodecs.hpp>
+#include "cylfe/media.hpp"
 #include <opencv2/imgproc.hpp>
 
 using namespace cylfe;
@@ -37,7 +37,7 @@ void usage(FILE *f)
         "Render a synthetic drive of the robot through a scene of cylinder landmarks into a raw\n"
         "frame log (YUYV frames, odometry with covariance, true poses and landmarks).\n"
         "\n"
-        "  -o, --output PATH       raw log to write (default build/drive.cylraw)\n"
+        "  -o, --output PATH       raw log to write (default drive.cylraw in the current directory)\n"
         "  -n, --frames N          number of frames (default 1000)\n"
         "  -s, --seed N            random seed: noise, odometry, exposure (default 7)\n"
         "  -S, --scene NAME|PATH   'default' or 'hard' (built in), 'empty', or a scene file (YAML/JSON,\n"
@@ -85,7 +85,7 @@ void write_labelled_frame(const std::string &dir, uint64_t k, const cyl_image &i
     cv::Mat yuyv(H, W, CV_8UC2, const_cast<uint8_t *>(img.plane[0]), img.stride[0]), bgr;
     cv::cvtColor(yuyv, bgr, cv::COLOR_YUV2BGR_YUYV);
     const std::string png = dir + "/images/" + stem + ".png";
-    if (!cv::imwrite(png, bgr)) throw Error(png + ": cannot write image");
+    if (!cylfe::media::imwrite(png, bgr)) throw Error(png + ": cannot write image");
     struct Bx { int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1; long n = 0; };
     std::vector<Bx> bx(scene.cylinders.size());
     for (int y = 0; y < H; y++)
@@ -118,7 +118,7 @@ void write_labelled_frame(const std::string &dir, uint64_t k, const cyl_image &i
 int main(int argc, char **argv)
 {
     if (cylfe::print_version_if_asked(argc, argv, "cyl-render")) return 0;
-    std::string out = "build/drive.cylraw", scene_name = "default", write_scene, write_table, write_camera, labels_dir;
+    std::string out = "drive.cylraw", scene_name = "default", write_scene, write_table, write_camera, labels_dir;
     uint64_t frames = 1000, seed = 7, samples = 0;
     bool quiet = false, calib_error = false;
     for (int i = 1; i < argc; i++) {

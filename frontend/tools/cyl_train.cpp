@@ -11,14 +11,14 @@
 #include <vector>
 #include <unistd.h>
 
-#include <opencv2/highgui.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/highgui.hpp>  // window flags and events only: windows are in the media plugin
 #include <opencv2/imgproc.hpp>
 
 #include "cylfe/version.hpp"
 #include "cylfe/calib.hpp"
 #include "cylfe/error.hpp"
 #include "cylfe/learn.hpp"
+#include "cylfe/media.hpp"
 #include "cylfe/progress.hpp"
 
 using namespace cylfe;
@@ -339,8 +339,8 @@ int run_gui(Opts &o, cyl_colortable &t, const cyl_train_params &params)
     if (!o.gui_classes.empty()) g.cls = (unsigned)cyl_colortable_find_class(&g.table, o.gui_classes.front().c_str());
     std::string snapshot = o.snapshot.empty() ? o.out + ".png" : o.snapshot;
     const std::string win = "cyl-train";
-    cv::namedWindow(win, cv::WINDOW_AUTOSIZE | cv::WINDOW_GUI_NORMAL);  // Qt: no toolbar or status bar
-    cv::setMouseCallback(win, on_mouse, &g);
+    cylfe::media::named_window(win, cv::WINDOW_AUTOSIZE | cv::WINDOW_GUI_NORMAL);  // Qt: no toolbar or status bar
+    cylfe::media::set_mouse_callback(win, on_mouse, &g);
     g.status = "drag a rectangle over a landmark";
     g.base = g.table;
     g.labels_path = o.save_labels;
@@ -362,12 +362,12 @@ int run_gui(Opts &o, cyl_colortable &t, const cyl_train_params &params)
     std::fflush(stdout);
     for (;;) {
         if (g.dirty) {
-            cv::imshow(win, render(g));
+            cylfe::media::imshow(win, render(g));
             g.dirty = false;
         }
-        int k = cv::waitKey(20);
+        int k = cylfe::media::wait_key(20);
         if (k < 0) {
-            if (cv::getWindowProperty(win, cv::WND_PROP_AUTOSIZE) < 0) break;  // window closed
+            if (cylfe::media::window_property(win, cv::WND_PROP_AUTOSIZE) < 0) break;  // window closed
             continue;
         }
         k &= 0xff;
@@ -442,7 +442,7 @@ int run_gui(Opts &o, cyl_colortable &t, const cyl_train_params &params)
         } else if (k == 'p') {
             try {
                 std::vector<uint8_t> buf;
-                cv::imencode(".png", render(g), buf);
+                cylfe::media::imencode_png(render(g), buf);
                 write_file_atomic(snapshot, std::string(buf.begin(), buf.end()));
                 g.status = "wrote " + snapshot;
                 std::printf("cyl-train: wrote %s\n", snapshot.c_str());
@@ -452,7 +452,7 @@ int run_gui(Opts &o, cyl_colortable &t, const cyl_train_params &params)
         }
         std::fflush(stdout);
     }
-    cv::destroyAllWindows();
+    cylfe::media::destroy_all_windows();
     return kExitOk;
 }
 

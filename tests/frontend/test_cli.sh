@@ -170,6 +170,28 @@ for t in cyl cyl-render cyl-train cyl-calibrate cyl-synth-validate cyl_paper; do
 done
 finish
 
+# `cyl` links OpenCV's core and imgproc only: image and video files and windows come from the
+# media plugin, loaded at first use (a camera or raw log in, observations out loads none of it)
+start lean_linking
+n=$(ldd "$CYL" | wc -l)
+[ "$n" -le 80 ] || fail "ldd $CYL lists $n libraries (at most 80)"
+ldd "$CYL" | grep -E "opencv_(highgui|videoio|imgcodecs)|libQt|libgdal|libavcodec" && fail "cyl links a codec, video or GUI library"
+expect_exit 0 "" -- "$CYL" detect synthetic:2 --max-frames 2 --out "$T/lean.jsonl" --quiet
+# an image file needs the plugin: it works with it, and without it the error names the plugin and where it looked
+python3 -c "
+import struct, zlib
+w, h = 640, 480
+raw = b''.join(b'\\x00' + bytes([120, 120, 120] * w) for _ in range(h))
+chunk = lambda t, d: struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d) & 0xffffffff)
+open('$T/grey.png', 'wb').write(b'\\x89PNG\\r\\n\\x1a\\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', w, h, 8, 2, 0, 0, 0))
+                                + chunk(b'IDAT', zlib.compress(raw)) + chunk(b'IEND', b''))"
+expect_exit 0 "" -- "$CYL" detect "$T/grey.png" --table $TABLE --calib $CALIB --out "$T/png.jsonl" --quiet
+grep -q '"type":"frame"' "$T/png.jsonl" 2>/dev/null || fail "no frame record from the PNG"
+expect_exit 1 "need the plugin libcyl-media.so .*$T/none.so: not there; CYL_MEDIA_PLUGIN names it" -- \
+  env CYL_MEDIA_PLUGIN="$T/none.so" "$CYL" detect "$T/grey.png" --table $TABLE --calib $CALIB --out "$T/png2.jsonl" --quiet
+[ ! -e "$T/png2.jsonl" ] || fail "a log was left behind after the plugin error"
+finish
+
 echo "[==========] $((passed + failed)) tests ran."
 echo "[  PASSED  ] $passed tests."
 [ $failed -eq 0 ] || echo "[  FAILED  ] $failed tests."

@@ -53,6 +53,9 @@ std::string detector_config_yaml(const DetectorConfig &cfg, const cyl_colortable
 // Load a mask image (any OpenCV-readable format; non-zero = keep) into cfg.
 void load_detector_mask(const std::string &path, DetectorConfig &cfg);
 
+// A JSON string literal for s (quotes included, escaped as the observation log writes it).
+std::string json_quote(const std::string &s);
+
 // Owns the caller-side memory libcyl needs and runs segmentation + observation per frame.
 class Detector {
 public:

@@ -11,7 +11,9 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // cv::IMREAD_* only
+
+#include "cylfe/media.hpp"
 #include <opencv2/imgproc.hpp>
 
 #include "cylfe/error.hpp"
@@ -61,7 +63,7 @@ std::vector<View> detect_views(const std::vector<std::string> &paths, const Boar
         const std::string &p = paths[i];
         cv::Mat gray;
         try {
-            gray = cv::imread(p, cv::IMREAD_GRAYSCALE);
+            gray = cylfe::media::imread(p, cv::IMREAD_GRAYSCALE);
         } catch (const cv::Exception &e) {
             throw Error(p + ": unreadable image: " + e.what());
         }

@@ -16,7 +16,7 @@
 
 #include "cylfe/error.hpp"
 
-#include <opencv2/imgcodecs.hpp>
+#include "cylfe/media.hpp"
 #include <opencv2/imgproc.hpp>
 
 namespace cylfe {
@@ -596,7 +596,7 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
             std::string stem = path.substr(slash == std::string::npos ? 0 : slash + 1);
             if (dot != std::string::npos && dot > (slash == std::string::npos ? 0 : slash)) stem.resize(stem.find_last_of('.'));
             const std::string out = o.overlay_dir + "/" + stem + ".png";
-            if (!cv::imwrite(out, vis)) throw Error(out + ": cannot write overlay image");
+            if (!cylfe::media::imwrite(out, vis)) throw Error(out + ": cannot write overlay image");
         }
         res.images++;
         if (progress) progress(++done, images.size());

@@ -3,7 +3,7 @@
 #include "cylfe/synth_experiments.hpp"
 #include "cylfe/error.hpp"
 
-#include <opencv2/imgcodecs.hpp>
+#include "cylfe/media.hpp"
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -62,7 +62,7 @@ struct Axes {
     }
     void save(const std::string &path)
     {
-        if (!cv::imwrite(path, img)) throw Error(path + ": cannot write plot");
+        if (!media::imwrite(path, img)) throw Error(path + ": cannot write plot");
     }
 };
 
