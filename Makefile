@@ -72,6 +72,7 @@ cross: $(STAMP)/debs-cross
 
 install: lib
 	$(MAKE) -C libcyl BUILD=$(HOSTLIB:libcyl/%=%) install PREFIX=$(or $(PREFIX),/usr/local)
+	$(MAKE) install-tools PREFIX=$(or $(PREFIX),/usr/local)
 
 # ---- tests ------------------------------------------------------------------
 TEST_COMMON_SRCS := $(wildcard tests/common/*.c)

@@ -14,13 +14,12 @@
 #include <unistd.h>
 #include <vector>
 
-#include <opencv2/highgui.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "cylfe/version.hpp"
 #include "cylfe/calibration.hpp"
+#include "cylfe/data_files.hpp"
 #include "cylfe/error.hpp"
+#include "cylfe/media.hpp"
 #include "cylfe/overlay.hpp"
 #include "cylfe/pipeline.hpp"
 #include "cylfe/progress.hpp"
@@ -51,6 +50,7 @@ const char *kUsage =
     "  detect SOURCE        run detection, write the observation log (JSON Lines, docs/formats.md)\n"
     "  record SOURCE        record a source to a raw frame log (.cylraw)\n"
     "  info FILE.cylraw     describe a raw frame log\n"
+    "  info CAMERA.yaml     the camera a calibration file gives, as libcyl sees it (JSON)\n"
     "  devices              list V4L2 devices              (same as --list-devices)\n"
     "  formats [DEVICE]     list a device's pixel formats  (same as --list-formats)\n"
     "  controls [DEVICE]    list a device's controls       (same as --list-controls)\n"
@@ -62,7 +62,8 @@ const char *kUsage =
     "  synthetic[:SEED]              the built-in synthetic scene, with odometry and ground truth\n"
     "\n"
     "detect options:\n"
-    "  --table FILE         colour table (libcyl CYLT file); synthetic default calib_data/synthetic.cylt\n"
+    "  --table FILE         colour table (libcyl CYLT file); synthetic default synthetic.cylt from the\n"
+    "                       data directory (CYL_DATA_DIR, else PREFIX/share/cyl or calib_data/)\n"
     "  --calib FILE         camera calibration (OpenCV or ROS YAML, with libcyl's mount and sigma\n"
     "                       fields); for the synthetic source the default is the scene's own camera\n"
     "  --out FILE|-         observation log (default -, stdout); a regular file is written as\n"
@@ -320,7 +321,7 @@ int cmd_detect(const Args &a)
                         "with --overlay DIR|FILE.avi instead");
     }
     bool synthetic = is_synthetic(a.source);
-    std::string table_path = a.table.empty() && synthetic ? "calib_data/synthetic.cylt" : a.table;
+    std::string table_path = a.table.empty() && synthetic ? cylfe::data_file("synthetic.cylt") : a.table;
     if (table_path.empty()) usage_error("detect: --table is required");
     if (a.calib.empty() && !synthetic) usage_error("detect: --calib is required");
 
@@ -381,11 +382,11 @@ int cmd_detect(const Args &a)
     ObservationLog log(a.out, hdr);
 
     bool overlay_dir = false;
-    cv::VideoWriter video;
+    cylfe::media::VideoWriter video;
     if (!a.overlay.empty()) {
         std::string o = a.overlay;
         if (o.size() > 4 && o.compare(o.size() - 4, 4, ".avi") == 0) {
-            if (!video.open(o, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 15.0,
+            if (!video.open(o, cylfe::media::VideoWriter::fourcc('M', 'J', 'P', 'G'), 15.0,
                             cv::Size((int)src->info().width, (int)src->info().height)))
                 throw Error(o + ": cannot open video for writing");
         } else {
@@ -412,18 +413,18 @@ int cmd_detect(const Args &a)
             frames++;
             observations += obs.size();
             truncated += det.truncated();
-            if (overlay_dir || video.isOpened() || a.show) {
+            if (overlay_dir || video.is_open() || a.show) {
                 cv::Mat bgr = to_bgr(ev.image);
                 draw_overlay(bgr, det, obs);
                 if (overlay_dir) {
                     char name[64];
                     std::snprintf(name, sizeof name, "/frame_%06llu.png", (unsigned long long)ev.header.seq);
-                    if (!cv::imwrite(a.overlay + name, bgr)) throw Error(a.overlay + name + ": cannot write image");
+                    if (!cylfe::media::imwrite(a.overlay + name, bgr)) throw Error(a.overlay + name + ": cannot write image");
                 }
-                if (video.isOpened()) video.write(bgr);
+                if (video.is_open()) video.write(bgr);
                 if (a.show) {
-                    cv::imshow("cyl", bgr);
-                    int key = cv::waitKey(1);
+                    cylfe::media::imshow("cyl", bgr);
+                    int key = cylfe::media::wait_key(1);
                     if (key == 'q' || key == 27) g_interrupted = 1;
                 }
             }
@@ -438,7 +439,7 @@ int cmd_detect(const Args &a)
     progress.update(src->progress(), frames, frames / (now_s() - t0 + 1e-9));
     progress.done();
     log.close();
-    if (video.isOpened()) video.release();
+    if (video.is_open()) video.close();
     double dt = now_s() - t0;
     if (!a.quiet)
         std::fprintf(stderr, "cyl detect: %llu frames, %llu observations, %.1f frames/s, %llu dropped by the source%s%s\n",
@@ -488,9 +489,36 @@ int cmd_record(const Args &a)
     return g_interrupted ? kExitInterrupted : kExitOk;
 }
 
+// `cyl info CAMERA.yaml`: the camera a calibration file gives, as libcyl sees it (cyl/camera.h
+// field names and units), one JSON object; every number at full precision.
+int info_camera(const Args &a)
+{
+    CameraCalibration cal = load_camera_calibration(a.source, a.lenient);
+    for (const std::string &w : cal.warnings) std::fprintf(stderr, "cyl: warning: %s\n", w.c_str());
+    const cyl_camera &c = cal.cam;
+    std::printf("{\"file\":%s,\"format\":\"%s\",\"mount_known\":%s,\"intrinsic_cov_known\":%s,"
+                "\"mount_sigmas_known\":%s,\"camera\":{\"width\":%u,\"height\":%u",
+                json_quote(a.source).c_str(), cal.format.c_str(), cal.mount_known ? "true" : "false",
+                cal.intrinsic_cov_known ? "true" : "false", cal.mount_sigmas_known ? "true" : "false", c.width, c.height);
+    const std::pair<const char *, double> f[] = {
+        {"fx_px", c.fx_px}, {"fy_px", c.fy_px}, {"cx_px", c.cx_px}, {"cy_px", c.cy_px}, {"k1", c.k1}, {"k2", c.k2},
+        {"p1", c.p1}, {"p2", c.p2}, {"k3", c.k3}, {"tilt_rad", c.tilt_rad}, {"yaw_rad", c.yaw_rad},
+        {"height_m", c.height_m}, {"offset_m", c.offset_m}, {"tilt_sigma_rad", c.tilt_sigma_rad},
+        {"yaw_sigma_rad", c.yaw_sigma_rad}, {"height_sigma_m", c.height_sigma_m}, {"offset_sigma_m", c.offset_sigma_m}};
+    for (const auto &kv : f) std::printf(",\"%s\":%.17g", kv.first, kv.second);
+    std::printf(",\"flags\":%u,\"intr_cov\":[", c.flags);
+    for (int i = 0; i < CYL_INTR_COUNT; i++)
+        for (int j = 0; j < CYL_INTR_COUNT; j++) std::printf("%s%.17g", i || j ? "," : "", c.intr_cov[i][j]);
+    std::printf("]}}\n");
+    return kExitOk;
+}
+
 int cmd_info(const Args &a)
 {
     if (a.source.empty()) usage_error("info: no FILE given");
+    const size_t dot = a.source.find_last_of('.');
+    const std::string ext = dot == std::string::npos ? "" : a.source.substr(dot);
+    if (ext == ".yaml" || ext == ".yml") return info_camera(a);
     RawLogReader r(a.source);
     const StreamInfo &i = r.info();
     std::map<uint32_t, uint64_t> counts;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // cyl_paper: the paper's Tables 6, 8 and 9 recomputed with libcyl's uncertainty model, printed
 // beside the paper's own figures. The camera comes from a calibration file (default
-// calib_data/paper_camera.yaml, the paper's Table 4/5 camera). The last line is a JSON object.
+// paper_camera.yaml from the data directory, the paper's Table 4/5 camera). The last line is a JSON object.
 //
 // Each row is a full observation: the landmark (a cylinder, --diameter x --height m) is placed
 // at the row's range and bearing in the robot frame, projected through the camera, rendered as
@@ -17,6 +17,7 @@
 
 #include "cylfe/version.hpp"
 #include "cylfe/calibration.hpp"
+#include "cylfe/data_files.hpp"
 #include "cylfe/error.hpp"
 
 extern "C" {
@@ -97,7 +98,7 @@ cyl_observation observe(const cyl_camera &cam, cyl_geom_model model, double rang
 int main(int argc, char **argv)
 {
     if (cylfe::print_version_if_asked(argc, argv, "cyl_paper")) return 0;
-    std::string cam_path = "calib_data/paper_camera.yaml";
+    std::string cam_path;
     cyl_geom_model model = CYL_GEOM_EXACT;
     double D = 0.10, H = 0.10;  // largest fully visible at the 1.19 m row (docs)
     for (int i = 1; i < argc; i++) {
@@ -115,11 +116,14 @@ int main(int argc, char **argv)
         } else if (a == "--diameter") D = std::stod(val());
         else if (a == "--height") H = std::stod(val());
         else if (a == "-h" || a == "--help") {
-            std::printf("usage: cyl_paper [--camera FILE] [--model exact|paper] [--diameter M] [--height M] [--version]\n");
+            std::printf("usage: cyl_paper [--camera FILE] [--model exact|paper] [--diameter M] [--height M] [--version]\n"
+                        "  --camera FILE   default paper_camera.yaml from the data directory (CYL_DATA_DIR,\n"
+                        "                  else PREFIX/share/cyl or the repository's calib_data/)\n");
             return 0;
         } else { std::fprintf(stderr, "cyl_paper: unknown argument %s\n", a.c_str()); return cylfe::kExitUsage; }
     }
     try {
+        if (cam_path.empty()) cam_path = cylfe::data_file("paper_camera.yaml");
         cylfe::CameraCalibration cal = cylfe::load_camera_calibration(cam_path);
         if (!cal.mount_known) throw cylfe::Error(cam_path + ": no mount_* fields: range and bearing need the mount");
         const cyl_camera &cam = cal.cam;

@@ -30,7 +30,7 @@ void usage(FILE *f)
         "usage: cyl-synth-validate [options]\n"
         "Reproduce the paper's consistency experiments (Tables 1-3, 6-7, landmark confidence) on\n"
         "rendered frames with known truth; print the tables, write plots; last line JSON.\n"
-        "  --out DIR        plots and CSV files (default build/validate)\n"
+        "  --out DIR        plots and CSV files (default validate/ in the current directory)\n"
         "  --scene S        'default' or a scene file (default: default)\n"
         "  --frames N       frames per row of Tables 1-3 (default 400)\n"
         "  --runs N         calibration-error runs for Tables 6-7 (default 500, 3 landmarks each)\n"
@@ -181,7 +181,7 @@ void print_rb_tables(const char *title, const std::vector<RbSample> &s)
 int main(int argc, char **argv)
 {
     if (cylfe::print_version_if_asked(argc, argv, "cyl-synth-validate")) return 0;
-    std::string out = "build/validate", scene_name = "default";
+    std::string out = "validate", scene_name = "default";
     unsigned frames = 400, runs = 500, conf_frames = 600, sweep_frames = 150;
     bool sweep = false, sweep_only = false, pixel_only = false;
     uint64_t seed = 1;

@@ -17,7 +17,9 @@ msg=""
 env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL -u SAN make -s install SAN= PREFIX="$T/prefix" >"$T/log" 2>&1 ||
   msg="make install failed: $(tail -5 "$T/log")"
 for f in include/cyl/version.h include/cyl/colorlearn.h lib/libcyl.a lib/libcyl.so lib/pkgconfig/libcyl.pc \
-         lib/cmake/cyl/cylConfig.cmake lib/cmake/cyl/cylConfigVersion.cmake; do
+         lib/cmake/cyl/cylConfig.cmake lib/cmake/cyl/cylConfigVersion.cmake \
+         bin/cyl bin/cyl-train bin/cyl-score bin/cyl-calibrate bin/cyl-render bin/cyl-synth-validate bin/cyl_paper \
+         share/cyl/synthetic.cylt share/cyl/paper_camera.yaml lib/cyl/libcyl-media.so; do
   [ -f "$T/prefix/$f" ] || msg="$msg; $f not installed"
 done
 result prefix "$msg"
@@ -56,6 +58,32 @@ else
   ldd "$T/cm/consumer_static" | grep -q "libcyl.so" && msg="$msg; consumer_static uses libcyl.so"
 fi
 result cmake_consumer "$msg"
+
+echo "[ RUN      ] install.tools_from_any_directory"
+msg=""
+mkdir -p "$T/elsewhere" "$T/nodata"
+# the installed cyl finds its default colour table in PREFIX/share/cyl, not in the repository
+(cd "$T/elsewhere" && "$T/prefix/bin/cyl" detect synthetic:3 --max-frames 2 --out obs.jsonl) >"$T/tool.log" 2>&1 ||
+  msg="installed cyl detect synthetic failed in another directory: $(tail -3 "$T/tool.log")"
+n=$(grep -c "\"type\":\"frame\"" "$T/elsewhere/obs.jsonl" 2>/dev/null)
+[ "${n:-0}" -ge 2 ] || msg="$msg; $n frame records in the installed tool's log"
+(cd "$T/elsewhere" && "$T/prefix/bin/cyl_paper") >"$T/paper.log" 2>&1 ||
+  msg="$msg; installed cyl_paper failed in another directory: $(tail -3 "$T/paper.log")"
+tail -1 "$T/paper.log" | grep -q '^{' || msg="$msg; cyl_paper's last line is not JSON"
+# CYL_DATA_DIR overrides the search, and a wrong one is an error naming the file and the place
+(cd "$T/elsewhere" && CYL_DATA_DIR="$T/nodata" "$T/prefix/bin/cyl" detect synthetic --max-frames 1 --out o2.jsonl) \
+  >"$T/nodata.log" 2>&1; rc=$?
+[ $rc -eq 1 ] || msg="$msg; CYL_DATA_DIR without the table: exit $rc, expected 1"
+grep -q "synthetic.cylt: data file not found (looked at $T/nodata/synthetic.cylt; CYL_DATA_DIR is set" "$T/nodata.log" ||
+  msg="$msg; unexpected error: $(head -c 300 "$T/nodata.log")"
+cp "$T/prefix/share/cyl/synthetic.cylt" "$T/nodata/"
+(cd "$T/elsewhere" && CYL_DATA_DIR="$T/nodata" "$T/prefix/bin/cyl" detect synthetic --max-frames 1 --out o3.jsonl) \
+  >"$T/data.log" 2>&1 || msg="$msg; CYL_DATA_DIR with the table failed: $(tail -2 "$T/data.log")"
+# the installed media plugin: an overlay image written from the installed tool
+(cd "$T/elsewhere" && "$T/prefix/bin/cyl" detect synthetic --max-frames 1 --out o4.jsonl --overlay ov/) \
+  >"$T/ov.log" 2>&1 || msg="$msg; installed cyl --overlay failed: $(tail -2 "$T/ov.log")"
+[ -s "$T/elsewhere/ov/frame_000000.png" ] || msg="$msg; no overlay image from the installed tool"
+result tools_from_any_directory "$msg"
 
 echo "[==========] $((passed + failed)) tests ran."
 echo "[  PASSED  ] $passed tests."
