@@ -17,6 +17,27 @@ def ellipse_points(mean, cov, k2=CHI2_2_95, n=48):
     return pts.T + np.asarray(mean, float)[:2]
 
 
+MAGNIFICATIONS = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000)
+
+
+def ellipse_magnification(covs, extent_m, target=0.015):
+    """The factor the 95 % ellipses are drawn at so that they can be seen: the smallest of
+    MAGNIFICATIONS that makes the median ellipse's semi-major axis at least `target` of the
+    plot's extent (1 when they are large enough already). The legend states it."""
+    covs = [np.asarray(c, float)[:2, :2] for c in covs if c is not None]
+    if not covs or not extent_m > 0:
+        return 1
+    semi = np.median([math.sqrt(max(np.linalg.eigvalsh(c)[-1], 0.0) * CHI2_2_95) for c in covs])
+    for m in MAGNIFICATIONS:
+        if m * semi >= target * extent_m:
+            return m
+    return MAGNIFICATIONS[-1]
+
+
+def _times(m):
+    return ", true size" if m == 1 else f", drawn x{m}"
+
+
 def _apply(R, t, poses):
     out = np.array(poses, float).copy()
     out[:, :2] = out[:, :2] @ R.T + t
@@ -32,7 +53,7 @@ def plot(path, ds, res, title, res_fixed=None, dead_reckoning=None, match=None, 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(9, 8))
+    fig, ax = plt.subplots(figsize=(11.5, 8))
     tr = [s.truth for s in ds.steps if s.truth is not None]
     if tr:
         tr = np.array(tr)
@@ -53,18 +74,27 @@ def plot(path, ds, res, title, res_fixed=None, dead_reckoning=None, match=None, 
                 label="fixed covariance" + tag, zorder=2)
     ax.plot(poses[:, 0], poses[:, 1], color="tab:blue", lw=1.0,
             label="estimate (per-observation cov.)" + tag, zorder=3)
+    pts = [poses[:, :2], lms]
+    if tr is not None and len(tr):
+        pts.append(np.asarray(tr)[:, :2])
+    allp = np.concatenate([p for p in pts if len(p)])
+    extent = float(np.max(np.ptp(allp, axis=0))) if len(allp) > 1 else 1.0
     if res.pose_cov is not None:
         step = max(1, len(res.poses) // 40)
-        for i in range(0, len(res.poses), step):
+        idx = list(range(0, len(res.poses), step))
+        mp = ellipse_magnification([res.pose_cov[i] for i in idx], extent)
+        for k, i in enumerate(idx):
             c = res.pose_cov[i][:2, :2]
-            th = poses[i, 2]
-            R = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
-            e = ellipse_points(poses[i], R @ c @ R.T)
-            ax.plot(e[:, 0], e[:, 1], color="tab:blue", lw=0.5, alpha=0.6, zorder=3)
+            th = res.poses[i, 2]
+            R = R0 @ np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
+            e = ellipse_points(poses[i], (mp * mp) * (R @ c @ R.T))
+            ax.plot(e[:, 0], e[:, 1], color="tab:blue", lw=0.5, alpha=0.6, zorder=3,
+                    label=f"pose 95% ellipses{_times(mp)}" if k == 0 else None)
     if ds.truth_landmarks:
         t = np.array([v[:2] for v in ds.truth_landmarks.values()])
         ax.scatter(t[:, 0], t[:, 1], marker="x", color="k", s=50, label="true landmarks", zorder=4)
     classes = sorted(set(res.lm_class))
+    ml = ellipse_magnification(res.lm_cov if res.lm_cov is not None else [], extent)
     colours = {"orange": "tab:orange", "green": "tab:green", "barcode": "tab:purple",
                "tree": "tab:green"}
     cyc = ["tab:purple", "tab:cyan", "tab:olive", "tab:pink", "tab:brown"]
@@ -74,18 +104,19 @@ def plot(path, ds, res, title, res_fixed=None, dead_reckoning=None, match=None, 
         if not js:
             continue
         p = lms[js]
-        ax.scatter(p[:, 0], p[:, 1], s=14, color=col, label=f"landmarks ({c}) + 95% ellipses",
-                   zorder=5)
+        ell = f" + 95% ellipses{_times(ml)}" if res.lm_cov is not None else ""
+        ax.scatter(p[:, 0], p[:, 1], s=14, color=col, label=f"landmarks ({c}){ell}", zorder=5)
         if res.lm_cov is not None:
             for j in js:
-                e = ellipse_points(lms[j], R0 @ res.lm_cov[j] @ R0.T)
+                e = ellipse_points(lms[j], (ml * ml) * (R0 @ res.lm_cov[j] @ R0.T))
                 ax.plot(e[:, 0], e[:, 1], color=col, lw=0.9, zorder=5)
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_title(title, fontsize=10)
-    ax.legend(loc="best", fontsize=7)
+    # the legend beside the axes, never over the data
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, fontsize=7)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
