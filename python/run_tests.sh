@@ -6,6 +6,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mkdir -p build/python/cyl
-ln -sf ../../../python/cyl/__init__.py build/python/cyl/__init__.py
+for f in python/cyl/*.py; do
+  [ "$(basename "$f")" = _build.py ] || ln -sf "../../../$f" "build/python/cyl/$(basename "$f")"
+done
 CYL_CFFI_TMPDIR=build/python .venv/bin/python python/cyl/_build.py
 exec env PYTHONPATH=build/python .venv/bin/python -m pytest -q -p no:cacheprovider python/tests "$@"

@@ -6,6 +6,7 @@
     frame = np.zeros((480, 1280), np.uint8)            # a 640x480 YUYV frame, 2 bytes per pixel
     blobs = cyl.segment(table, frame, "YUYV")          # list of cyl.Blob
     cam = cyl.Camera(640, 480, fx=570, fy=568, cx=322.4, cy=236.9, tilt_rad=0.209, height_m=0.326)
+    cam = cyl.load_camera("calib_data/synthetic_camera.yaml")   # or from a calibration file
     obs = cyl.observe(table, frame, "YUYV", cam, sizes={"orange": (0.10, 0.30)})   # list of dicts
 
 Frames are C-contiguous uint8 arrays in the camera's own layout: YUYV and UYVY as (H, 2W) or
@@ -22,7 +23,8 @@ import numpy as np
 
 from ._cyl import ffi, lib
 
-__all__ = ["CylError", "Table", "Blob", "Camera", "segment", "observe", "version", "FORMATS"]
+__all__ = ["CylError", "Table", "Blob", "Camera", "CameraFileError", "load_camera", "segment", "observe", "version",
+           "FORMATS"]
 
 FORMATS = {"YUYV": lib.CYL_FMT_YUYV, "UYVY": lib.CYL_FMT_UYVY, "NV12": lib.CYL_FMT_NV12,
            "I420": lib.CYL_FMT_I420, "YU12": lib.CYL_FMT_I420}
@@ -201,6 +203,21 @@ class Camera:
         _check(lib.cyl_camera_check(c), "camera")
         self._c = c
 
+    @classmethod
+    def load(cls, path: str, lenient: bool = False) -> "Camera":
+        """A calibration file (OpenCV or ROS YAML with libcyl's mount fields): see load_camera."""
+        return load_camera(path, lenient)
+
+    _FIELDS = ("width", "height", "fx_px", "fy_px", "cx_px", "cy_px", "k1", "k2", "p1", "p2", "k3", "tilt_rad",
+               "yaw_rad", "height_m", "offset_m", "tilt_sigma_rad", "yaw_sigma_rad", "height_sigma_m",
+               "offset_sigma_m", "flags")
+
+    def fields(self) -> dict:
+        """Every field of the C camera (cyl/camera.h names and units), intr_cov as a 9x9 list."""
+        d = {k: getattr(self._c, k) for k in self._FIELDS}
+        d["intr_cov"] = [[self._c.intr_cov[i][j] for j in range(9)] for i in range(9)]
+        return d
+
 
 def observe(table: Table, frame: np.ndarray, fmt: str, camera: Camera,
             sizes: Optional[Dict[str, Tuple[float, float]]] = None, estimator: str = "image",
@@ -239,3 +256,6 @@ def observe(table: Table, frame: np.ndarray, fmt: str, camera: Camera,
         })
     del keep
     return out
+
+
+from .camera_file import CameraFileError, load_camera  # noqa: E402  (needs Camera above)

@@ -24,6 +24,7 @@ typedef uint8_t cyl_mask;
 #define CYL_OBS_NO_RANGE ...
 #define CYL_OBS_INVALID ...
 #define CYL_OBS_NONLINEAR ...
+#define CYL_MAX_DIM ...
 const char *cyl_status_str(cyl_status s);
 const char *cyl_version(void);
 
@@ -62,7 +63,10 @@ cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img, const cyl_
 typedef struct cyl_camera { uint32_t width; uint32_t height; double fx_px; double fy_px; double cx_px; double cy_px;
                             double k1; double k2; double p1; double p2; double k3; double tilt_rad; double yaw_rad;
                             double height_m; double offset_m; double tilt_sigma_rad; double yaw_sigma_rad;
-                            double height_sigma_m; double offset_sigma_m; ...; } cyl_camera;
+                            double height_sigma_m; double offset_sigma_m; double intr_cov[9][9]; uint32_t flags;
+                            ...; } cyl_camera;
+#define CYL_CAM_INTR_COV_UNKNOWN ...
+#define CYL_CAM_EXTR_SIG_UNKNOWN ...
 void cyl_camera_init(cyl_camera *cam);
 void cyl_camera_set_intrinsic_sigmas(cyl_camera *cam, const double sigma[9]);
 cyl_status cyl_camera_check(const cyl_camera *cam);
