@@ -53,3 +53,10 @@ TEST_EXTRA_BINS += pytest:python/run_tests.sh
 pip-check:
 	@scripts/pip-check.sh
 .PHONY: pip-check
+
+# make bag-demo: make demo's drive written as a ROS bag and read back with cyl-robotlog
+# (scripts/bag-demo.sh; BAG_STORAGE=mcap|sqlite3|ros1, BAG_JPEG=1); last line JSON
+bag-demo: $(BUILD)/cyl $(BUILD)/cyl-render $(VENV)/.stamp
+	@python/build.sh >/dev/null
+	@BUILD=$(BUILD) scripts/bag-demo.sh
+.PHONY: bag-demo

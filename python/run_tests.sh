@@ -5,9 +5,5 @@
 # CYL_BUILD names the C tools' folder).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-mkdir -p build/python/cyl
-for f in python/cyl/*.py; do
-  [ "$(basename "$f")" = _build.py ] || ln -sf "../../../$f" "build/python/cyl/$(basename "$f")"
-done
-CYL_CFFI_TMPDIR=build/python .venv/bin/python python/cyl/_build.py
+python/build.sh
 exec env PYTHONPATH=build/python .venv/bin/python -m pytest -q -p no:cacheprovider python/tests "$@"
