@@ -163,7 +163,38 @@ def process(ds, args, label, outdir):
     return summary
 
 
+def _tum_line(t, x, y, th):
+    return f"{t:.9f} {x:.9f} {y:.9f} 0 0 0 {math.sin(th / 2):.12f} {math.cos(th / 2):.12f}\n"
+
+
+def _kitti_line(x, y, th):
+    c, s = math.cos(th), math.sin(th)
+    return f"{c:.12g} {-s:.12g} 0 {x:.9f} {s:.12g} {c:.12g} 0 {y:.9f} 0 0 1 0\n"
+
+
+def write_trajectory_files(outdir, ds, res):
+    """TUM (`t x y z qx qy qz qw`) and KITTI (3x4 row-major) files of the estimate and, when the
+    log has it, the truth, for evo (`evo_ape tum truth.tum trajectory.tum -a`); landmarks.tum lists
+    the landmark map with the landmark's index as its timestamp."""
+    with open(os.path.join(outdir, "trajectory.tum"), "w") as ft, \
+            open(os.path.join(outdir, "trajectory_kitti.txt"), "w") as fk:
+        for i, s in enumerate(ds.steps):
+            ft.write(_tum_line(s.t, *res.poses[i]))
+            fk.write(_kitti_line(*res.poses[i]))
+    steps = [s for s in ds.steps if s.truth is not None]
+    if steps:
+        with open(os.path.join(outdir, "truth.tum"), "w") as ft, \
+                open(os.path.join(outdir, "truth_kitti.txt"), "w") as fk:
+            for s in steps:
+                ft.write(_tum_line(s.t, *s.truth))
+                fk.write(_kitti_line(*s.truth))
+    with open(os.path.join(outdir, "landmarks.tum"), "w") as fh:
+        for j in range(len(res.lms)):
+            fh.write(_tum_line(float(j), res.lms[j, 0], res.lms[j, 1], 0.0))
+
+
 def write_outputs(outdir, ds, res, m):
+    write_trajectory_files(outdir, ds, res)
     with open(os.path.join(outdir, "trajectory.csv"), "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["step", "seq", "t", "x_m", "y_m", "theta_rad", "cov_xx", "cov_xy", "cov_xt",
@@ -233,7 +264,7 @@ def print_summary(s, out=sys.stdout):
               f"{f('anees_landmarks_fixed_cov')}, association errors "
               f"{f('association_errors_fixed_cov')}", file=out)
     if s.get("outputs"):
-        print(f"   outputs: {s['outputs']}/(trajectory.csv, landmarks.csv, summary.json, plot.png)",
+        print(f"   outputs: {s['outputs']}/(trajectory.csv, landmarks.csv, trajectory.tum, summary.json, plot.png)",
               file=out)
 
 

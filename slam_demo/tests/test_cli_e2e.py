@@ -46,8 +46,34 @@ def test_cli_run_writes_outputs_and_json_last_line(tmp_path):
     for k in ("ate_m", "landmark_rmse_m", "anees_landmarks", "association_errors",
               "ate_fixed_cov_m"):
         assert last[k] is not None
-    for f in ("trajectory.csv", "landmarks.csv", "summary.json", "plot.png"):
+    for f in ("trajectory.csv", "landmarks.csv", "summary.json", "plot.png", "trajectory.tum", "truth.tum",
+              "trajectory_kitti.txt", "truth_kitti.txt", "landmarks.tum"):
         assert os.path.getsize(tmp_path / f) > 0
+
+
+def test_evo_reads_the_tum_output_and_agrees_on_ate(tmp_path):
+    """evo (the standard trajectory evaluation tool) on trajectory.tum against truth.tum, aligned
+    with Umeyama (SE(3), as `evo_ape tum truth.tum trajectory.tum -a`), gives the run's own ATE."""
+    from evo.core import metrics as evo_metrics
+    from evo.core import sync
+    from evo.tools import file_interface
+    r = _cli("run", SHORT, "--out", str(tmp_path), "--fixed-cov", "none", "--no-plot")
+    assert r.returncode == 0, r.stderr
+    ate = json.loads(r.stdout.strip().splitlines()[-1])["ate_m"]
+    ref = file_interface.read_tum_trajectory_file(str(tmp_path / "truth.tum"))
+    est = file_interface.read_tum_trajectory_file(str(tmp_path / "trajectory.tum"))
+    ref, est = sync.associate_trajectories(ref, est)
+    est.align(ref, correct_scale=False)
+    ape = evo_metrics.APE(evo_metrics.PoseRelation.translation_part)
+    ape.process_data((ref, est))
+    evo_ate = ape.get_statistic(evo_metrics.StatisticsType.rmse)
+    assert ate > 0.001 and abs(evo_ate - ate) < 1e-3, (evo_ate, ate)
+    # KITTI files: one 3x4 row-major pose per line, the same poses
+    k = np.loadtxt(tmp_path / "trajectory_kitti.txt")
+    t = np.loadtxt(tmp_path / "trajectory.tum")
+    assert k.shape == (len(t), 12)
+    np.testing.assert_allclose(k[:, [3, 7]], t[:, [1, 2]], atol=1e-8)
+    np.testing.assert_allclose(np.arctan2(k[:, 4], k[:, 0]), 2 * np.arctan2(t[:, 6], t[:, 7]), atol=1e-9)
     traj = np.genfromtxt(tmp_path / "trajectory.csv", delimiter=",", names=True)
     assert len(traj) == 300
 
