@@ -792,6 +792,9 @@ def main(argv=None) -> int:
     b.add_argument("--jpeg-quality", type=int, default=95)
     b.add_argument("--time-offset", type=float, default=1.0, help="added to every stamp, s (default %(default)s: "
                    "ROS reads a stamp of 0 as unset)")
+    o = sp.add_parser("obs-to-mcap", help="an observation log (JSON Lines) as MCAP for Foxglove and the mcap library")
+    o.add_argument("log", help="observation log (cyl detect --out)")
+    o.add_argument("-o", "--out", required=True, help="MCAP file to write")
     m = sp.add_parser("merge-odom-csv", help="odometry from a CSV file merged into a raw log")
     m.add_argument("raw", help="raw log (.cylraw)")
     m.add_argument("csv", help="CSV odometry: t_s,x_m,y_m,theta_rad[,cov_vx,cov_vxvy,cov_vxwz,cov_vy,cov_vywz,cov_wz]")
@@ -822,13 +825,18 @@ def main(argv=None) -> int:
                                int(round(args.time_offset * 1e9)))
             print(f"cyl-robotlog: wrote {args.out} ({args.storage}): "
                   + ", ".join(f"{v} {k}" for k, v in counts.items()), file=sys.stderr)
+        elif args.cmd == "obs-to-mcap":
+            from .obs_mcap import convert
+            counts = convert(args.log, args.out)
+            print(f"cyl-robotlog: wrote {args.out}: " + ", ".join(f"{v} {k}" for k, v in counts.items() if v),
+                  file=sys.stderr)
         else:
             track = read_odometry_csv(args.csv)
             rep = merge_odometry(args.raw, track, args.out, _noise(args.odom_noise), args.max_gap, args.bridge_gaps)
             for line in rep.lines():
                 print(f"cyl-robotlog: {line}", file=sys.stderr)
             print(f"cyl-robotlog: wrote {args.out}", file=sys.stderr)
-    except (RobotLogError, rawlog.RawLogError) as e:
+    except (RobotLogError, rawlog.RawLogError, ValueError) as e:
         print(f"cyl-robotlog: error: {e}", file=sys.stderr)
         return 1
     except OSError as e:
