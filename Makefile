@@ -30,7 +30,7 @@ CXXFLAGS_ALL := -std=c++17 -O2 -g -Wall -Wextra -Ilibcyl/include -Itests/common 
 
 DEBS_BUILD := build-essential pkg-config libcmocka-dev
 DEBS_CROSS := gcc-arm-none-eabi libnewlib-arm-none-eabi
-DEBS_CV    := libopencv-dev libyaml-cpp-dev
+DEBS_CV    := libopencv-dev libyaml-cpp-dev libjpeg-dev
 DEBS_BENCH := valgrind
 
 STAMP := $(BUILD)/.stamps

@@ -5,12 +5,13 @@ FRONTEND_OBJS := $(FRONTEND_SRCS:frontend/src/%.cpp=$(BUILD)/frontend/%.o)
 FRONTEND_A := $(BUILD)/frontend/libfrontend.a
 FRONTEND_HDRS := $(wildcard frontend/include/cylfe/*.hpp)
 CV_FLAGS = $(shell pkg-config --cflags opencv4 2>/dev/null)
-# what the frontend links: OpenCV, and yaml-cpp for calibration files (frontend/src/calibration.cpp)
-CV_LIBS = $(shell pkg-config --libs opencv4 2>/dev/null) -lyaml-cpp
+# what the frontend links: OpenCV, yaml-cpp for calibration files (frontend/src/calibration.cpp) and
+# libjpeg(-turbo) for MJPG cameras (frontend/src/mjpeg.cpp)
+CV_LIBS = $(shell pkg-config --libs opencv4 2>/dev/null) -lyaml-cpp -ljpeg
 # what `cyl` links: OpenCV's core and imgproc only. Image and video files and windows go through
 # the plugin libcyl-media.so (frontend/include/cylfe/media.hpp), loaded when first used, so the
 # robot's case (camera or raw log in, observations out) loads no codec, video or GUI stack.
-CV_LIBS_CORE = -lopencv_imgproc -lopencv_core -lyaml-cpp
+CV_LIBS_CORE = -lopencv_imgproc -lopencv_core -lyaml-cpp -ljpeg
 MEDIA_SO := $(BUILD)/libcyl-media.so
 MEDIA_LIBS = -lopencv_highgui -lopencv_videoio -lopencv_imgcodecs -lopencv_core
 
@@ -28,7 +29,8 @@ $(FRONTEND_A): $(FRONTEND_OBJS) | $(MEDIA_SO)
 
 # ---- V4L2 against the kernel's vivid driver, under qemu (part of make test) --------------
 DEBS_VIVID := qemu-system-x86 busybox-static cpio kmod xz-utils binutils
-VIVID_SRCS := tests/v4l2/vivid_test.cpp frontend/src/v4l2.cpp frontend/src/rawlog.cpp frontend/src/output_file.cpp
+VIVID_SRCS := tests/v4l2/vivid_test.cpp frontend/src/v4l2.cpp frontend/src/mjpeg.cpp frontend/src/rawlog.cpp \
+  frontend/src/output_file.cpp
 # Static, so the VM needs nothing else; under SAN=1 dynamic (the sanitizer runtimes are shared
 # libraries) and scripts/vivid-test.sh copies its libraries into the VM.
 ifeq ($(SAN),1)
@@ -38,7 +40,7 @@ VIVID_LINK := -static
 endif
 $(BUILD)/vivid_test: $(VIVID_SRCS) $(FRONTEND_HDRS) lib
 	@mkdir -p $(dir $@)
-	$(CXX) $(CXXFLAGS_ALL) $(VIVID_LINK) $(VIVID_SRCS) -o $@ $(LIBCYL_A) -lm
+	$(CXX) $(CXXFLAGS_ALL) $(VIVID_LINK) $(VIVID_SRCS) -o $@ $(LIBCYL_A) -ljpeg -lm
 TEST_EXTRA += $(STAMP)/debs-vivid $(BUILD)/vivid_test
 TEST_EXTRA_BINS += scripts/vivid-test.sh:$(BUILD)/vivid_test
 vivid-test: $(STAMP)/debs-vivid $(BUILD)/vivid_test

@@ -20,7 +20,7 @@ SYNTH_OBJS := $(FE_SYNTH_OBJS)
 endif
 SYNTH_A := $(BUILD)/synth/libsynth.a
 SYNTH_FE_A := $(or $(FRONTEND_A),$(BUILD)/frontend/libfrontend.a)
-SYNTH_CV = $$(pkg-config --cflags --libs opencv4) -lyaml-cpp
+SYNTH_CV = $$(pkg-config --cflags --libs opencv4) -lyaml-cpp -ljpeg
 
 $(SYNTH_A): $(SYNTH_OBJS)
 	@mkdir -p $(dir $@)

@@ -7,7 +7,7 @@
 # hence the literal path).
 UNC_FE_OBJ := $(BUILD)/frontend/libfrontend.a
 UNC_CV_CFLAGS = $$(pkg-config --cflags opencv4)
-UNC_CV_LIBS = $$(pkg-config --libs opencv4) -lyaml-cpp
+UNC_CV_LIBS = $$(pkg-config --libs opencv4) -lyaml-cpp -ljpeg
 
 $(BUILD)/cyl_paper: frontend/tools/cyl_paper.cpp $(UNC_FE_OBJ) lib
 	@mkdir -p $(dir $@)

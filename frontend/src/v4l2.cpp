@@ -152,6 +152,24 @@ std::vector<uint32_t> offered_formats(int fd)
 
 } // namespace
 
+uint32_t choose_v4l2_format(const std::vector<uint32_t> &offered, uint32_t asked, const std::string &dev)
+{
+    auto has = [&](uint32_t f) { return std::find(offered.begin(), offered.end(), f) != offered.end(); };
+    std::string list;
+    for (uint32_t p : offered) list += " " + fourcc_str(p);
+    if (list.empty()) list = " nothing";
+    if (asked == 0) {
+        for (uint32_t p : kPreferred)
+            if (has(p)) return p;
+        if (has(V4L2_PIX_FMT_MJPEG)) return V4L2_PIX_FMT_MJPEG;
+        throw Error(dev + ": offers none of YUYV, UYVY, NV12, YU12 or MJPG (the device offers:" + list + ")");
+    }
+    if (asked != V4L2_PIX_FMT_MJPEG && pixfmt_from_fourcc(asked) == 0)
+        throw Error(dev + ": libcyl cannot read pixel format " + fourcc_str(asked) + " (YUYV, UYVY, NV12, YU12 or MJPG)");
+    if (!has(asked)) throw Error(dev + ": format " + fourcc_str(asked) + " not offered (the device offers:" + list + ")");
+    return asked;
+}
+
 void V4L2Source::request_stop() { g_stop = 1; }
 void V4L2Source::clear_stop() { g_stop = 0; }
 
@@ -175,20 +193,9 @@ V4L2Source::V4L2Source(const V4L2Options &opt) : dev_(opt.device), timeout_ms_(o
             if (xioctl(fd_, VIDIOC_S_INPUT, &in) == -1) throw Error(err(dev_, "cannot select input " + std::to_string(in)));
         }
 
-        // Pixel format: the one asked for, or the first libcyl reads.
-        std::vector<uint32_t> offered = offered_formats(fd_);
-        uint32_t want = opt.fourcc;
-        if (want == 0) {
-            for (uint32_t p : kPreferred)
-                if (std::find(offered.begin(), offered.end(), p) != offered.end()) { want = p; break; }
-            if (want == 0) throw Error(dev_ + ": offers none of YUYV, UYVY, NV12, YU12");
-        }
-        if (pixfmt_from_fourcc(want) == 0) throw Error(dev_ + ": libcyl cannot read pixel format " + fourcc_str(want));
-        if (std::find(offered.begin(), offered.end(), want) == offered.end()) {
-            std::string list;
-            for (uint32_t p : offered) list += " " + fourcc_str(p);
-            throw Error(dev_ + ": format " + fourcc_str(want) + " not offered (the device offers:" + list + ")");
-        }
+        // Pixel format: the one asked for, or the first libcyl reads (a YUV layout, else MJPG).
+        const uint32_t want = choose_v4l2_format(offered_formats(fd_), opt.fourcc, dev_);
+        mjpeg_ = want == V4L2_PIX_FMT_MJPEG;
         v4l2_format fmt;
         std::memset(&fmt, 0, sizeof fmt);
         fmt.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
@@ -207,16 +214,17 @@ V4L2Source::V4L2Source(const V4L2Options &opt) : dev_(opt.device), timeout_ms_(o
             throw Error(dev_ + ": size " + std::to_string(opt.width) + "x" + std::to_string(opt.height) +
                         " not offered (driver chose " + std::to_string(fmt.fmt.pix.width) + "x" +
                         std::to_string(fmt.fmt.pix.height) + ")");
-        cyl_pixfmt pf = pixfmt_from_fourcc(want);
-        info_.fourcc = want;
+        // MJPG frames are decoded to YUYV: the stream carries that layout from here on.
+        cyl_pixfmt pf = mjpeg_ ? CYL_FMT_YUYV : pixfmt_from_fourcc(want);
+        info_.fourcc = mjpeg_ ? fourcc_from_pixfmt(CYL_FMT_YUYV) : want;
         info_.width = fmt.fmt.pix.width;
         info_.height = fmt.fmt.pix.height;
-        info_.stride = fmt.fmt.pix.bytesperline;
+        info_.stride = mjpeg_ ? 2 * fmt.fmt.pix.width : fmt.fmt.pix.bytesperline;
         info_.frame_bytes = (uint32_t)cyl_image_buffer_size(pf, info_.width, info_.height, info_.stride);
-        if (info_.frame_bytes == 0 || info_.frame_bytes > fmt.fmt.pix.sizeimage)
+        if (info_.frame_bytes == 0 || (!mjpeg_ && info_.frame_bytes > fmt.fmt.pix.sizeimage))
             throw Error(dev_ + ": driver layout (bytesperline " + std::to_string(info_.stride) + ", sizeimage " +
                         std::to_string(fmt.fmt.pix.sizeimage) + ") is not the contiguous layout libcyl reads");
-        info_.source = "v4l2 " + std::string(reinterpret_cast<const char *>(cap.driver));
+        info_.source = std::string(mjpeg_ ? "v4l2 mjpg " : "v4l2 ") + reinterpret_cast<const char *>(cap.driver);
 
         // Frame interval.
         v4l2_streamparm parm;
@@ -341,7 +349,29 @@ bool V4L2Source::next(SourceEvent &ev)
         }
         if (b.index >= bufs_.size()) throw Error(dev_ + ": driver returned an unknown buffer index");
         queued_index_ = (int)b.index;
-        if (b.bytesused && b.bytesused < info_.frame_bytes)
+        if (mjpeg_) {
+            // Decode now, then hand the buffer straight back: a corrupt frame (USB cameras do send
+            // them) is skipped and counted as dropped, not the end of the run.
+            bool ok = b.bytesused > 0 && !(b.flags & V4L2_BUF_FLAG_ERROR);
+            if (ok) {
+                try {
+                    decoder_.decode(static_cast<const uint8_t *>(bufs_[b.index].start),
+                                    std::min<size_t>(b.bytesused, bufs_[b.index].length), info_.width, info_.height,
+                                    decoded_, dev_ + ": frame " + std::to_string(b.sequence));
+                } catch (const Error &) {
+                    ok = false;
+                }
+            }
+            if (xioctl(fd_, VIDIOC_QBUF, &b) == -1) {
+                if (errno == ENODEV) throw Error(dev_ + ": device disconnected");
+                throw Error(err(dev_, "VIDIOC_QBUF"));
+            }
+            queued_index_ = -1;
+            if (!ok) {  // counted as dropped by the sequence gap at the next good frame
+                corrupt_++;
+                continue;
+            }
+        } else if (b.bytesused && b.bytesused < info_.frame_bytes)
             throw Error(dev_ + ": short frame (" + std::to_string(b.bytesused) + " of " +
                         std::to_string(info_.frame_bytes) + " bytes)");
         if (last_seq_ >= 0 && (int64_t)b.sequence > last_seq_ + 1) dropped_ += (uint64_t)((int64_t)b.sequence - last_seq_ - 1);
@@ -355,7 +385,7 @@ bool V4L2Source::next(SourceEvent &ev)
         ev.header.flags = (b.flags & V4L2_BUF_FLAG_ERROR) ? 1u : 0u;
         if ((b.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC)
             info_.flags |= StreamInfo::kMonotonic;
-        ev.data = static_cast<const uint8_t *>(bufs_[b.index].start);
+        ev.data = mjpeg_ ? decoded_.data() : static_cast<const uint8_t *>(bufs_[b.index].start);
         check(cyl_image_wrap(&ev.image, pixfmt_from_fourcc(info_.fourcc), info_.width, info_.height, ev.data, info_.stride),
               dev_ + ": frame layout");
         return true;

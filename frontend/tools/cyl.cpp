@@ -56,7 +56,7 @@ const char *kUsage =
     "  controls [DEVICE]    list a device's controls       (same as --list-controls)\n"
     "\n"
     "SOURCE is one of:\n"
-    "  /dev/videoN, v4l2:DEVICE      a V4L2 camera (YUYV, UYVY, NV12 or YU12)\n"
+    "  /dev/videoN, v4l2:DEVICE      a V4L2 camera (YUYV, UYVY, NV12, YU12, or MJPG decoded to YUYV)\n"
     "  FILE.cylraw, raw:FILE         a recorded raw frame log\n"
     "  IMAGE, VIDEO, file:PATH       image or video files (through OpenCV)\n"
     "  synthetic[:SEED]              the built-in synthetic scene, with odometry and ground truth\n"

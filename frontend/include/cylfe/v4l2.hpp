@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "cylfe/mjpeg.hpp"
 #include "cylfe/source.hpp"
 
 namespace cylfe {
@@ -46,6 +47,11 @@ struct V4L2DeviceInfo {
     std::string path, driver, card, bus;
     bool capture;     // offers single-planar video capture with streaming
 };
+
+// The pixel format to capture: `asked` (a V4L2 fourcc, 0 = choose) among the `offered` ones.
+// Chosen: the first of YUYV, UYVY, NV12, YU12 offered, else MJPG (decoded to YUYV, cylfe/mjpeg.hpp).
+// Throws Error naming the device and what it offers when nothing fits.
+uint32_t choose_v4l2_format(const std::vector<uint32_t> &offered, uint32_t asked, const std::string &dev);
 
 class V4L2Source : public Source {
 public:
@@ -88,6 +94,10 @@ private:
     uint64_t dropped_ = 0, frames_ = 0;
     int64_t last_seq_ = -1;
     double interval_s_ = 0;
+    bool mjpeg_ = false;        // MJPG capture: frames decoded into decoded_ (YUYV)
+    MjpegDecoder decoder_;
+    std::vector<uint8_t> decoded_;
+    uint64_t corrupt_ = 0;      // MJPG frames that did not decode (skipped, counted as dropped)
 };
 
 // Devices /dev/video* with their driver, card and whether they can capture.
