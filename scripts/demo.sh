@@ -26,7 +26,8 @@ echo "== 2/3 detection: cyl detect -> $OUT/observations.jsonl"
   --size orange=0.10,0.30 --size green=0.10,0.30 \
   --out "$OUT/observations.jsonl" --overlay "$OUT/overlay.avi"
 echo "== 3/3 SLAM: per-observation covariance + calibration state, vs one tuned fixed covariance"
-PYTHONPATH=slam_demo .venv/bin/python -m cylslam run "$OUT/observations.jsonl" --out "$OUT/slam" --calib-states | tee "$OUT/slam.log"
+PYTHONPATH=slam_demo .venv/bin/python -m cylslam run "$OUT/observations.jsonl" --out "$OUT/slam" --calib-states \
+  --rerun "$OUT/slam/run.rrd" | tee "$OUT/slam.log"
 rm -f "$OUT/drive.cylraw"   # 614 MB: re-rendered on demand
 t1=$(date +%s)
 echo
@@ -34,5 +35,7 @@ echo "demo outputs in $OUT/:"
 echo "  observations.jsonl   the frontend's observation log (docs/formats.md)"
 echo "  overlay.avi          classified pixels, boxes, range/bearing, 95% ellipses"
 echo "  slam/plot.png        estimate vs truth with 95% ellipses; slam/summary.json, trajectory.csv, landmarks.csv"
+echo "  slam/trajectory.tum  TUM trajectories for evo (and truth.tum, KITTI files)"
+echo "  slam/run.rrd         the run as a rerun recording (rerun $OUT/slam/run.rrd)"
 echo "  demo time: $((t1 - t0)) s"
 tail -1 "$OUT/slam.log"

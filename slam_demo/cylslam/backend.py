@@ -177,9 +177,13 @@ class Result:
 
 
 class Slam:
-    def __init__(self, params: Params, progress=None):
+    def __init__(self, params: Params, progress=None, on_step=None):
+        """on_step(i, seq, t, pose, used, isam, lms_init): called after each step as the run
+        goes (the live view): `pose` the newest pose estimate, `used` the (observation, landmark
+        index) pairs added at this step, `isam` the solver (for landmark estimates)."""
         self.p = params
         self.progress = progress
+        self.on_step = on_step
 
     def _obs_noise(self, cov_rb):
         g = gtsam.noiseModel.Gaussian.Covariance(to_gtsam_cov(cov_rb))
@@ -269,6 +273,8 @@ class Slam:
                 e = isam.calculateEstimatePose2(X(i))
                 cur = np.array([e.x(), e.y(), e.theta()])
             if not usable:
+                if self.on_step:
+                    self.on_step(i, s.seq, s.t, cur, [], isam, lms_init)
                 continue
             covs = [p.fixed_cov if p.fixed_cov is not None else o.cov for o in usable]
             if mode == "known":
@@ -308,6 +314,9 @@ class Slam:
                 new_f.add(f)
                 assoc.append((i, o, j))
                 st["used"] += 1
+            if self.on_step:
+                self.on_step(i, s.seq, s.t, cur, [(o, j) for (k, o, j) in assoc[-len(usable):] if k == i],
+                             isam, lms_init)
         if new_f.size() or new_v.size():
             isam.update(new_f, new_v)
             st["isam_updates"] += 1

@@ -90,7 +90,14 @@ def process(ds, args, label, outdir):
     from . import metrics
     from .backend import Slam
     prog = Progress(label, args.progress)
-    res = Slam(_params(args), progress=prog).run(ds)
+    live = None
+    if getattr(args, "rerun", None) or getattr(args, "rerun_spawn", False):
+        from .live import LiveView
+        live = LiveView(save_path=args.rerun, spawn=args.rerun_spawn, images=args.rerun_images)
+    res = Slam(_params(args), progress=prog, on_step=live.step if live else None).run(ds)
+    if live:
+        live.final(ds, res)
+        live.close()
     m = metrics.evaluate(ds, res)
     summary = {"name": ds.name, "steps": len(ds.steps), "observations": ds.n_obs()}
     summary.update(_clean(m))
@@ -329,6 +336,12 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
     o = sp.add_argument_group("output")
     o.add_argument("--out", default=None, help="output directory (CSV, JSON, PNG)")
     o.add_argument("--no-plot", action="store_true", help="do not write plot.png")
+    o.add_argument("--rerun", metavar="FILE.rrd", default=None,
+                   help="live view with rerun (rerun-sdk), saved headless to FILE.rrd: robot, trajectory, "
+                        "observations, landmarks with 95%% ellipses as the run goes, then the final map")
+    o.add_argument("--rerun-spawn", action="store_true", help="open the rerun viewer and show the run live")
+    o.add_argument("--rerun-images", metavar="DIR", default=None,
+                   help="the overlay images of `cyl detect --overlay DIR` (frame_<seq>.png), shown per step")
     o.add_argument("--progress", dest="progress", action="store_true", default=sys.stderr.isatty(),
                    help="progress bar on stderr (default: when stderr is a terminal)")
     o.add_argument("--no-progress", dest="progress", action="store_false")
