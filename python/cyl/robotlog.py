@@ -91,6 +91,76 @@ class PoseTrack:
         return p, (i if f >= 0.5 else i - 1), (t1 - t0) * 1e-9
 
 
+class TfTree:
+    """Planar transforms from /tf (dynamic, timestamped) and /tf_static (constant), for odometry
+    as the chain between two named frames (e.g. odom -> base_link through base_footprint)."""
+
+    def __init__(self, what: str):
+        self.what = what
+        self.dynamic: Dict[Tuple[str, str], PoseTrack] = {}
+        self.static: Dict[Tuple[str, str], Tuple[float, float, float]] = {}
+
+    def add(self, tf, is_static: bool):
+        parent, child = tf.header.frame_id.lstrip("/"), tf.child_frame_id.lstrip("/")
+        tr, q = tf.transform.translation, tf.transform.rotation
+        pose = (tr.x, tr.y, yaw_of(q))
+        if is_static:
+            self.static[(parent, child)] = pose
+        else:
+            track = self.dynamic.setdefault((parent, child), PoseTrack(f"{self.what}: {parent} -> {child}"))
+            t = _stamp_ns(tf)
+            if track.t_ns and t == track.t_ns[-1]:
+                return                      # republished at the same stamp
+            track.add(t, pose, where=f", message {len(track.t_ns)}")
+
+    def chain(self, a: str, b: str):
+        """The links from frame a to frame b: [(parent, child, forward)], or raise naming the frames."""
+        edges = {}
+        for (p, c) in list(self.dynamic) + list(self.static):
+            edges.setdefault(p, []).append((c, (p, c, True)))
+            edges.setdefault(c, []).append((p, (p, c, False)))
+        prev = {a: None}
+        todo = [a]
+        while todo:
+            f = todo.pop(0)
+            for g, link in edges.get(f, []):
+                if g not in prev:
+                    prev[g] = (f, link)
+                    todo.append(g)
+        if b not in prev:
+            frames = sorted(edges)
+            raise RobotLogError(f"{self.what}: no transform chain from '{a}' to '{b}' (frames in /tf and /tf_static: "
+                                f"{', '.join(frames) or 'none'})")
+        links = []
+        f = b
+        while prev[f] is not None:
+            f0, link = prev[f]
+            links.append(link)
+            f = f0
+        return links[::-1]
+
+    def track(self, a: str, b: str) -> PoseTrack:
+        """The pose of frame b in frame a at the stamps of the chain's dynamic links, composed
+        along the chain (each dynamic link interpolated at each stamp)."""
+        links = self.chain(a, b)
+        dyn = [self.dynamic[(p, c)] for (p, c, _f) in links if (p, c) in self.dynamic]
+        if not dyn:
+            raise RobotLogError(f"{self.what}: the chain from '{a}' to '{b}' has no moving transform (only /tf_static)")
+        lo = max(d.t_ns[0] for d in dyn)
+        hi = min(d.t_ns[-1] for d in dyn)
+        stamps = sorted({t for d in dyn for t in d.t_ns if lo <= t <= hi})
+        out = PoseTrack(f"{self.what}: {a} -> {b}")
+        for t in stamps:
+            pose = (0.0, 0.0, 0.0)
+            for (p, c, fwd) in links:
+                link = self.dynamic[(p, c)].at(t)[0] if (p, c) in self.dynamic else self.static[(p, c)]
+                if not fwd:
+                    link = between(link, (0.0, 0.0, 0.0))   # the inverse transform
+                pose = compose(pose, link)
+            out.add(t, pose)
+        return out
+
+
 @dataclass
 class OdomNoise:
     """The odometry model used where the log carries no covariance: per frame-to-frame step,
@@ -287,6 +357,7 @@ def storage_of(path: Path) -> str:
 class ImportOptions:
     image_topic: str
     odom_topic: Optional[str] = None
+    tf_frames: Optional[Tuple[str, str]] = None   # odometry from /tf: (odometry frame, robot frame)
     truth_topic: Optional[str] = None
     truth_landmarks_topic: Optional[str] = None
     classes: Sequence[str] = ()          # class names in colour-table order (truth landmarks' ns)
@@ -325,9 +396,11 @@ def import_bag(bag: str, out: str, opt: ImportOptions, camera_info_out: Optional
         need(opt.image_topic, ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage"), "the camera images")
         if opt.odom_topic:
             need(opt.odom_topic, ("nav_msgs/msg/Odometry",), "the odometry")
+        elif opt.tf_frames:
+            need("/tf", ("tf2_msgs/msg/TFMessage",), "the transforms for --tf")
         elif not opt.allow_no_odometry:
-            raise RobotLogError(f"{bag}: no odometry topic given (--odom-topic); without odometry the SLAM demo "
-                                f"cannot place the frames (--no-odometry imports the frames alone)")
+            raise RobotLogError(f"{bag}: no odometry given (--odom-topic or --tf ODOM_FRAME:ROBOT_FRAME); without "
+                                f"odometry the SLAM demo cannot place the frames (--no-odometry imports the frames alone)")
         if opt.truth_topic:
             need(opt.truth_topic, ("nav_msgs/msg/Odometry", "geometry_msgs/msg/PoseStamped"), "the ground-truth poses")
         if opt.truth_landmarks_topic:
@@ -335,12 +408,14 @@ def import_bag(bag: str, out: str, opt: ImportOptions, camera_info_out: Optional
 
         # pass 1: odometry, truth, camera_info, frame times
         odom = PoseTrack(f"{bag}: {opt.odom_topic}")
+        tf = TfTree(f"{bag}: /tf")
         truth = PoseTrack(f"{bag}: {opt.truth_topic}")
         landmarks = []
         frame_t: List[int] = []
         cam_info = None
         want = [c for c in reader.connections if c.topic in
                 {opt.odom_topic, opt.truth_topic, opt.truth_landmarks_topic, opt.image_topic}
+                or (opt.tf_frames and c.topic in ("/tf", "/tf_static"))
                 or c.msgtype == "sensor_msgs/msg/CameraInfo"]
         for conn, _t, raw in reader.messages(connections=want):
             msg = reader.deserialize(raw, conn.msgtype)
@@ -357,6 +432,9 @@ def import_bag(bag: str, out: str, opt: ImportOptions, camera_info_out: Optional
                 p = msg.pose.pose
                 odom.add(t, (p.position.x, p.position.y, yaw_of(p.orientation)), _twist_cov(msg),
                          where=f", message {len(odom.t_ns)}")
+            elif opt.tf_frames and conn.topic in ("/tf", "/tf_static"):
+                for tr in msg.transforms:
+                    tf.add(tr, conn.topic == "/tf_static")
             elif conn.topic == opt.truth_topic:
                 p = msg.pose.pose if conn.msgtype == "nav_msgs/msg/Odometry" else msg.pose
                 truth.add(_stamp_ns(msg), (p.position.x, p.position.y, yaw_of(p.orientation)),
@@ -378,9 +456,11 @@ def import_bag(bag: str, out: str, opt: ImportOptions, camera_info_out: Optional
             raise RobotLogError(f"{bag}: {opt.image_topic}: no images")
         if opt.max_frames:
             frame_t = frame_t[:opt.max_frames]
-        if opt.odom_topic:
+        if opt.tf_frames:
+            odom = tf.track(*opt.tf_frames)
+        if opt.odom_topic or opt.tf_frames:
             if not odom.t_ns:
-                raise RobotLogError(f"{bag}: {opt.odom_topic}: no odometry messages")
+                raise RobotLogError(f"{odom.what}: no odometry messages")
             steps = odometry_records(frame_t, odom, opt.noise, opt.max_gap_s, opt.bridge_gaps, report)
         else:
             steps = [((0.0, 0.0, 0.0), None)] * len(frame_t)
@@ -421,7 +501,7 @@ def import_bag(bag: str, out: str, opt: ImportOptions, camera_info_out: Optional
                                     f"{writer.info.width}x{writer.info.height}")
             seq = report.frames
             writer.write(rawlog.FRAME, seq, t, payload)
-            if opt.odom_topic:
+            if opt.odom_topic or opt.tf_frames:
                 writer.write(rawlog.ODOMETRY, seq, t, rawlog.odometry_payload(*st))
             if opt.truth_topic:
                 got = truth.at(t)
@@ -505,18 +585,20 @@ def _set_yaw(q, th):
 
 
 ENCODING_OF = {"YUYV": "yuv422_yuy2", "UYVY": "yuv422", "NV12": "nv12"}
+TF_STATIC_LINK = (0.05, -0.02, 0.1)    # base_footprint -> base_link in write_bag's /tf_static (m, m, rad)
 
 
 def write_bag(raw: str, out: str, storage: str, camera=None, jpeg: bool = False, classes: Sequence[str] = (),
               jpeg_quality: int = 95, time_offset_ns: int = 1_000_000_000, topics=None,
-              progress=None) -> Dict[str, int]:
+              progress=None, tf: bool = False) -> Dict[str, int]:
     """A raw log as a bag: images (sensor_msgs/Image in the log's YUV layout, or CompressedImage
     JPEG), camera_info (from `camera`, a cyl.Camera), the odometry as nav_msgs/Odometry (the pose
     integrated from the increments, each increment's covariance as twist covariance over the frame
     interval), the ground truth as nav_msgs/Odometry and the truth landmarks as a MarkerArray of
     cylinders (namespace = class name). storage: 'mcap', 'sqlite3' (ROS 2) or 'ros1'. Every stamp
     is the log's time plus time_offset_ns (ROS reads a stamp of 0 as "not set", and the synthetic
-    scene's logs start at 0)."""
+    scene's logs start at 0). tf=True: the odometry also as /tf (odom -> base_footprint, moving)
+    and /tf_static (base_footprint -> base_link, TF_STATIC_LINK), composing to the same pose."""
     from rosbags.typesys import Stores, get_typestore
     topics = topics or {"image": "/camera/image_raw", "info": "/camera/camera_info", "odom": "/odom",
                         "truth": "/ground_truth", "landmarks": "/truth/landmarks"}
@@ -525,6 +607,9 @@ def write_bag(raw: str, out: str, storage: str, camera=None, jpeg: bool = False,
     if storage == "ros1":
         from rosbags.rosbag1 import Writer
         ts = get_typestore(Stores.ROS1_NOETIC)
+        if "tf2_msgs/msg/TFMessage" not in ts.types:   # the ROS 1 store lacks tf2_msgs
+            from rosbags.typesys import get_types_from_msg
+            ts.register(get_types_from_msg("geometry_msgs/TransformStamped[] transforms", "tf2_msgs/msg/TFMessage"))
         w = Writer(Path(out))
         ser = ts.serialize_ros1
     elif storage in ("mcap", "sqlite3"):
@@ -537,6 +622,8 @@ def write_bag(raw: str, out: str, storage: str, camera=None, jpeg: bool = False,
     if Path(out).exists():
         raise RobotLogError(f"{out}: exists; a bag is not overwritten")
     counts = {k: 0 for k in topics}
+    if tf:
+        counts.update(tf=0, tf_static=0)
     with rawlog.Reader(raw) as r:
         info = r.info
         if not jpeg and info.fourcc not in ENCODING_OF:
@@ -550,6 +637,18 @@ def write_bag(raw: str, out: str, storage: str, camera=None, jpeg: bool = False,
                     "truth": w.add_connection(topics["truth"], "nav_msgs/msg/Odometry", typestore=ts),
                     "landmarks": w.add_connection(topics["landmarks"], "visualization_msgs/msg/MarkerArray",
                                                   typestore=ts)}
+            if tf:
+                conn["tf"] = w.add_connection("/tf", "tf2_msgs/msg/TFMessage", typestore=ts)
+                conn["tf_static"] = w.add_connection("/tf_static", "tf2_msgs/msg/TFMessage", typestore=ts)
+
+            def transform(t_ns, parent, child, pose):
+                m = _default(ts, "geometry_msgs/msg/TransformStamped")
+                m.header, m.child_frame_id = _header(ts, t_ns, parent), child
+                m.transform.translation.x, m.transform.translation.y = pose[0], pose[1]
+                _set_yaw(m.transform.rotation, pose[2])
+                msg = _default(ts, "tf2_msgs/msg/TFMessage")
+                msg.transforms.append(m)
+                return msg
 
             def put(key, t_ns, msg, typename):
                 w.write(conn[key], t_ns, ser(msg, typename))
@@ -625,6 +724,12 @@ def write_bag(raw: str, out: str, storage: str, camera=None, jpeg: bool = False,
                         m.twist.twist.angular.z = d[2] / dt
                         m.twist.covariance = tw.ravel()
                     put("odom", rec.t_ns, m, "nav_msgs/msg/Odometry")
+                    if tf:
+                        if counts["tf_static"] == 0:
+                            put("tf_static", rec.t_ns, transform(rec.t_ns, "base_footprint", "base_link", TF_STATIC_LINK),
+                                "tf2_msgs/msg/TFMessage")
+                        foot = compose(pose, between(TF_STATIC_LINK, (0.0, 0.0, 0.0)))
+                        put("tf", rec.t_ns, transform(rec.t_ns, "odom", "base_footprint", foot), "tf2_msgs/msg/TFMessage")
                 elif rec.type == rawlog.TRUTH_POSE:
                     x, y, th = rec.truth_pose()
                     m = _default(ts, "nav_msgs/msg/Odometry")
@@ -767,6 +872,8 @@ def main(argv=None) -> int:
     a.add_argument("--image-topic", required=True, help="sensor_msgs/Image (yuv422_yuy2/yuyv, yuv422/uyvy, nv12, "
                    "rgb8, bgr8, mono8) or sensor_msgs/CompressedImage (JPEG)")
     a.add_argument("--odom-topic", help="nav_msgs/Odometry")
+    a.add_argument("--tf", metavar="ODOM_FRAME:ROBOT_FRAME", help="odometry from /tf (and /tf_static): the "
+                   "chain of transforms from the odometry frame to the robot's, e.g. odom:base_link")
     a.add_argument("--no-odometry", action="store_true", help="import the frames without odometry")
     a.add_argument("--truth-topic", help="ground-truth poses (nav_msgs/Odometry or geometry_msgs/PoseStamped)")
     a.add_argument("--truth-landmarks-topic", help="ground-truth landmarks (visualization_msgs/MarkerArray, "
@@ -789,6 +896,8 @@ def main(argv=None) -> int:
     b.add_argument("--classes", default="orange,green", help="class names for the landmark markers' namespaces "
                    "(default %(default)s)")
     b.add_argument("--jpeg", action="store_true", help="images as sensor_msgs/CompressedImage JPEG")
+    b.add_argument("--tf", action="store_true", help="the odometry also as /tf and /tf_static "
+                   "(odom -> base_footprint -> base_link)")
     b.add_argument("--jpeg-quality", type=int, default=95)
     b.add_argument("--time-offset", type=float, default=1.0, help="added to every stamp, s (default %(default)s: "
                    "ROS reads a stamp of 0 as unset)")
@@ -806,9 +915,15 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     try:
         if args.cmd == "import-bag":
-            if args.odom_topic and args.no_odometry:
-                p.error("--odom-topic and --no-odometry exclude each other")
-            opt = ImportOptions(image_topic=args.image_topic, odom_topic=args.odom_topic, truth_topic=args.truth_topic,
+            if sum(map(bool, (args.odom_topic, args.tf, args.no_odometry))) > 1:
+                p.error("--odom-topic, --tf and --no-odometry exclude each other")
+            tf_frames = None
+            if args.tf:
+                if args.tf.count(":") != 1 or not all(args.tf.split(":")):
+                    p.error("--tf ODOM_FRAME:ROBOT_FRAME (e.g. odom:base_link)")
+                tf_frames = tuple(args.tf.split(":"))
+            opt = ImportOptions(image_topic=args.image_topic, odom_topic=args.odom_topic, tf_frames=tf_frames,
+                                truth_topic=args.truth_topic,
                                 truth_landmarks_topic=args.truth_landmarks_topic,
                                 classes=[c for c in args.classes.split(",") if c], max_gap_s=args.max_gap,
                                 bridge_gaps=args.bridge_gaps, allow_no_odometry=args.no_odometry,
@@ -822,7 +937,7 @@ def main(argv=None) -> int:
             cam = load_camera(args.calib) if args.calib else None
             counts = write_bag(args.raw, args.out, args.storage, cam, args.jpeg,
                                [c for c in args.classes.split(",")], args.jpeg_quality,
-                               int(round(args.time_offset * 1e9)))
+                               int(round(args.time_offset * 1e9)), tf=args.tf)
             print(f"cyl-robotlog: wrote {args.out} ({args.storage}): "
                   + ", ".join(f"{v} {k}" for k, v in counts.items()), file=sys.stderr)
         elif args.cmd == "obs-to-mcap":

@@ -262,7 +262,7 @@ BAD_BAGS = {
              ("/odom", ODO, 3 * S, _odom(1))], CAM_ODOM,
             "an odometry gap of 2.000 s (at 2.000 s, frame 1) is longer than 0.5 s; --bridge-gaps"),
     "no_odom_topic": ([("/cam", IMG, S, _image())], ["--image-topic", "/cam"],
-                      "no odometry topic given (--odom-topic)"),
+                      "no odometry given (--odom-topic or --tf ODOM_FRAME:ROBOT_FRAME)"),
 }
 
 
@@ -333,3 +333,31 @@ def test_obs_to_mcap_rejects_other_files(tmp_path):
     r = cli("obs-to-mcap", str(p), "-o", str(tmp_path / "x.mcap"))
     assert r.returncode == 1 and "x.jsonl:2: record type 'blob' is not one of" in r.stderr
     assert not (tmp_path / "x.mcap").exists()
+
+
+@needs_tools
+@pytest.mark.parametrize("storage", ["mcap", "ros1"])
+def test_odometry_from_a_tf_chain(tmp_path, drive, storage):
+    """Odometry as the chain odom -> base_footprint (moving, /tf) -> base_link (/tf_static): the
+    composed pose gives the log's increments back; without covariance in TF, the model's."""
+    bag = str(tmp_path / ("t.bag" if storage == "ros1" else "t"))
+    r = cli("write-bag", drive, "-o", bag, "--storage", storage, "--tf")
+    assert r.returncode == 0, r.stderr
+    out = str(tmp_path / "tf.cylraw")
+    r = cli("import-bag", bag, "-o", out, "--image-topic", "/camera/image_raw", "--tf", "odom:base_link", "-q")
+    assert r.returncode == 0, r.stderr
+    assert "no twist covariance in the log: the odometry noise model was used" in r.stderr
+    _, a = records(drive)
+    _, b = records(out)
+    oa = [x.odometry() for x in a if x.type == rawlog.ODOMETRY]
+    ob = [x.odometry() for x in b if x.type == rawlog.ODOMETRY]
+    assert len(oa) == len(ob) == 24
+    for (da, _), (db, cb) in zip(oa[1:], ob[1:]):
+        np.testing.assert_allclose(db, da, rtol=0, atol=1e-9)
+        assert cb == pytest.approx(robotlog.OdomNoise().cov(db))
+    # a frame name that is not in the tree: the error lists the frames there are
+    r = cli("import-bag", bag, "-o", str(tmp_path / "x.cylraw"), "--image-topic", "/camera/image_raw",
+            "--tf", "odom:base_lnk", "-q")
+    assert r.returncode == 1
+    assert "no transform chain from 'odom' to 'base_lnk' (frames in /tf and /tf_static: base_footprint, base_link, odom)" \
+        in r.stderr, r.stderr
