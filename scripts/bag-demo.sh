@@ -8,7 +8,7 @@
 #   4. detect on it, and on the rendered log directly, and compare the two observation logs;
 #   5. run the SLAM demo on the imported log and evo's ATE on its TUM output.
 # The last line is make demo's JSON object plus "source" (the bag and its storage),
-# "same_observations_as_direct" and "evo_ate_m".
+# "same_observations_as_direct", "evo_ate_m" and "rerun_entities" (the run's rerun recording, read back).
 set -euo pipefail
 B=${BUILD:-build}
 OUT=${BAG_DEMO_OUT:-$B/bag-demo}
@@ -45,7 +45,7 @@ PY
 )
 rm -f "$OUT/drive.cylraw" "$OUT/imported.cylraw"   # 614 MB each
 echo "== 5/5 SLAM on the imported log, and evo's ATE on its TUM output"
-$PY -m cylslam run "$OUT/imported.jsonl" --out "$OUT/slam" --calib-states | tee "$OUT/slam.log"
+$PY -m cylslam run "$OUT/imported.jsonl" --out "$OUT/slam" --calib-states --rerun "$OUT/slam/run.rrd" | tee "$OUT/slam.log"
 evo=$($PY - "$OUT/slam" <<'PY'
 import sys
 from evo.core import metrics, sync
@@ -60,9 +60,16 @@ ape.process_data((ref, est))
 print(f"{ape.get_statistic(metrics.StatisticsType.rmse):.6f}")
 PY
 )
+# the rerun recording, read back: its entities
+ents=$($PY - "$OUT/slam/run.rrd" <<'PY'
+import json, sys
+from rerun.chunk import RrdReader
+print(json.dumps(sorted({str(c.entity_path).lstrip("/") for c in RrdReader(sys.argv[1]).stream().to_chunks()} - {"__properties"})))
+PY
+)
 tail -1 "$OUT/slam.log" | $PY -c "
 import json, sys
 r = json.loads(sys.stdin.read())
 r.update(source={'bag': '$BAG', 'storage': '$STORAGE', 'jpeg': ${BAG_JPEG:-0} == 1},
-         same_observations_as_direct='$same' == 'true', evo_ate_m=float('$evo'))
+         same_observations_as_direct='$same' == 'true', evo_ate_m=float('$evo'), rerun_entities=json.loads('$ents'))
 print(json.dumps(r))"
