@@ -117,7 +117,7 @@ bench: $(BUILD)/bench_segment $(BUILD)/bench_uncertainty $(BUILD)/bench_replay $
 clean:
 	rm -rf $(BUILD) libcyl/build
 
-# Issue 8's hardening checks (sanitizers, firmware + armhf, fuzz smoke, lint, soak), one after
+# The hardening checks (sanitizers, firmware + armhf, fuzz smoke, lint, soak), one after
 # another; .ci/run runs them after `make test`.
 ci-hardening:
 	scripts/ci-hardening.sh

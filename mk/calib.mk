@@ -19,7 +19,7 @@ CALIB_FE_A := $(BUILD)/frontend/libfrontend.a
 CALIB_SYNTH_OBJS := $(patsubst frontend/src/synth/%.cpp,$(BUILD)/frontend/synth/%.o,$(sort $(wildcard frontend/src/synth/*.cpp)))
 CALIB_HDRS := $(wildcard frontend/include/cylfe/*.hpp) $(wildcard libcyl/include/cyl/*.h)
 CALIB_CXXFLAGS = $(CXXFLAGS_ALL) -I/usr/include/eigen3 $(CV_FLAGS)
-CALIB_LIBS = $(CALIB_A) $(CALIB_FE_A) $(CALIB_SYNTH_OBJS) $(LIBCYL_A) -lceres -lglog -lgflags $(CV_LIBS) -lpthread -lm
+CALIB_LIBS = $(CALIB_A) $(CALIB_SYNTH_OBJS) $(CALIB_FE_A) $(LIBCYL_A) -lceres -lglog -lgflags $(CV_LIBS) -lpthread -lm
 CALIB_DEPS := $(CALIB_A) $(CALIB_FE_A) $(CALIB_SYNTH_OBJS) lib
 
 $(BUILD)/calib/%.o: frontend/src/calib/%.cpp $(CALIB_HDRS) $(wildcard frontend/src/calib/*.hpp) | $(STAMP)/debs-calib $(STAMP)/debs-cv

@@ -53,23 +53,23 @@ FE_SYNTH_OBJS := $(FE_SYNTH_SRCS:frontend/src/synth/%.cpp=$(BUILD)/frontend/synt
 $(BUILD)/frontend/synth/%.o: frontend/src/synth/%.cpp $(wildcard frontend/src/synth/*.hpp) $(FRONTEND_HDRS) $(wildcard libcyl/include/cyl/*.h) | $(STAMP)/debs-cv
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) -c $< -o $@
-$(BUILD)/cyl: frontend/tools/cyl.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
-	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) $< -o $@ $(FRONTEND_A) $(FE_SYNTH_OBJS) $(LIBCYL_A) $(CV_LIBS_CORE) -lm
+$(BUILD)/cyl: frontend/tools/cyl.cpp $(FE_SYNTH_OBJS) $(FRONTEND_A) lib
+	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) $< -o $@ $(FE_SYNTH_OBJS) $(FRONTEND_A) $(LIBCYL_A) $(CV_LIBS_CORE) -lm
 tools: $(BUILD)/cyl
 .PHONY: tools
 
 # ---- frontend unit tests (GoogleTest) ------------------------------------------------------
 FE_TEST_SRCS := $(sort $(wildcard tests/frontend/test_*.cpp))
 FE_TEST_BINS := $(FE_TEST_SRCS:tests/frontend/%.cpp=$(BUILD)/tests/fe_%)
-$(BUILD)/tests/fe_%: tests/frontend/%.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
+$(BUILD)/tests/fe_%: tests/frontend/%.cpp $(FE_SYNTH_OBJS) $(FRONTEND_A) lib
 	@mkdir -p $(dir $@)
-	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) $< -o $@ $(FRONTEND_A) $(FE_SYNTH_OBJS) $(LIBCYL_A) $(CV_LIBS) -lgtest -lgtest_main -pthread -lm
+	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) $< -o $@ $(FE_SYNTH_OBJS) $(FRONTEND_A) $(LIBCYL_A) $(CV_LIBS) -lgtest -lgtest_main -pthread -lm
 TEST_EXTRA += $(FE_TEST_BINS)
 TEST_EXTRA_BINS += $(FE_TEST_BINS)
 
 # ---- make bench: end-to-end replay ------------------------------------------------
-$(BUILD)/bench_replay: bench/bench_replay.cpp $(FRONTEND_A) $(FE_SYNTH_OBJS) lib
-	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) -O2 $< -o $@ $(FRONTEND_A) $(FE_SYNTH_OBJS) $(LIBCYL_A) $(CV_LIBS) -lm
+$(BUILD)/bench_replay: bench/bench_replay.cpp $(FE_SYNTH_OBJS) $(FRONTEND_A) lib
+	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) -O2 $< -o $@ $(FE_SYNTH_OBJS) $(FRONTEND_A) $(LIBCYL_A) $(CV_LIBS) -lm
 
 # ---- the cyl tool as a user meets it (exit codes, bad input, SIGINT) --------------------------
 TEST_EXTRA += $(BUILD)/cyl $(BUILD)/cyl-render $(BUILD)/cyl-synth-validate $(BUILD)/cyl_paper
