@@ -5,6 +5,7 @@
 #pragma once
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -20,35 +21,75 @@ namespace bench {
 constexpr uint32_t kW = 640, kH = 480;
 inline const uint8_t kOrange[3] = {150, 80, 190}, kGreen[3] = {140, 60, 70};
 
-// Coloured rectangles (landmarks and clutter), sensor noise and speckle.
-inline std::vector<uint8_t> make_frame(uint64_t seed)
+// The frame sets of the benchmark:
+//   typical  walls and furniture, 3-5 upright coloured "cylinders", sensor noise, 0.2% specks
+//            (1-12% of the pixels coloured: what a robot usually sees);
+//   dense    about half the frame coloured in 25-120 rectangles of both classes, sensor noise
+//            (a worst case for run detection and blob merging);
+//   speckle  the typical frame with 5% single-pixel specks of the class colours (a worst case for
+//            the background skip).
+enum class FrameSet { Typical, Dense, Speckle };
+
+inline const char *set_name(FrameSet s)
+{
+    return s == FrameSet::Typical ? "typical" : s == FrameSet::Dense ? "dense" : "speckle";
+}
+
+inline std::vector<uint8_t> make_frame(uint64_t seed, FrameSet set = FrameSet::Typical, uint32_t W = kW,
+                                       uint32_t H = kH, cyl_pixfmt fmt = CYL_FMT_YUYV)
 {
     test_rng r;
     test_rng_seed(&r, seed);
     canvas c;
-    canvas_alloc(&c, kW, kH);
+    canvas_alloc(&c, W, H);
     canvas_fill(&c, 110, 128, 128);
+    const double sx = W / 640.0, sy = H / 480.0;  // the layout scales with the frame
     for (int i = 0; i < 6; i++) {  // walls and furniture in neutral colours
-        canvas_rect(&c, (int32_t)test_rng_int(&r, 0, kW), (int32_t)test_rng_int(&r, 0, kH),
-                    (int32_t)test_rng_int(&r, 20, 200), (int32_t)test_rng_int(&r, 20, 200),
+        canvas_rect(&c, (int32_t)test_rng_int(&r, 0, W), (int32_t)test_rng_int(&r, 0, H),
+                    (int32_t)(test_rng_int(&r, 20, 200) * sx), (int32_t)(test_rng_int(&r, 20, 200) * sy),
                     (uint8_t)test_rng_int(&r, 40, 220), (uint8_t)test_rng_int(&r, 110, 145),
                     (uint8_t)test_rng_int(&r, 110, 145));
     }
-    int n = (int)test_rng_int(&r, 3, 6);
-    for (int i = 0; i < n; i++) {  // cylinders seen from the side: upright rectangles
-        const uint8_t *col = (i % 2) ? kGreen : kOrange;
-        int w = (int)test_rng_int(&r, 12, 60);
-        canvas_rect(&c, (int32_t)test_rng_int(&r, 0, kW - w), (int32_t)test_rng_int(&r, 100, 300), w,
-                    (int32_t)(w * 3), col[0], col[1], col[2]);
+    if (set == FrameSet::Dense) {
+        // rectangles of both classes until about half the frame is coloured
+        int n = (int)test_rng_int(&r, 25, 120);
+        const double mean_area = 0.8 * W * H / n;  // overlaps leave about half coloured
+        for (int i = 0; i < n; i++) {
+            const uint8_t *col = (i % 2) ? kGreen : kOrange;
+            const double a = mean_area * (0.5 + test_rng_int(&r, 0, 100) / 100.0);
+            const double aspect = 0.3 + test_rng_int(&r, 0, 100) / 40.0;
+            int w = (int)std::max(2.0, std::sqrt(a * aspect)), h = (int)std::max(2.0, a / w);
+            canvas_rect(&c, (int32_t)test_rng_int(&r, 0, W - 1), (int32_t)test_rng_int(&r, 0, H - 1), w, h, col[0],
+                        col[1], col[2]);
+        }
+    } else {
+        int n = (int)test_rng_int(&r, 3, 6);
+        for (int i = 0; i < n; i++) {  // cylinders seen from the side: upright rectangles
+            const uint8_t *col = (i % 2) ? kGreen : kOrange;
+            int w = (int)(test_rng_int(&r, 12, 60) * sx);
+            canvas_rect(&c, (int32_t)test_rng_int(&r, 0, W - w), (int32_t)(test_rng_int(&r, 100, 300) * sy), w,
+                        (int32_t)(w * 3), col[0], col[1], col[2]);
+        }
     }
     canvas_noise(&c, &r, 3.0, 3.0);
     const uint8_t speck[2][3] = {{150, 80, 190}, {140, 60, 70}};
-    canvas_speckle(&c, &r, 0.002, speck, 2);
-    std::vector<uint8_t> buf(kW * kH * 2);
+    canvas_speckle(&c, &r, set == FrameSet::Speckle ? 0.05 : 0.002, speck, 2);
+    std::vector<uint8_t> buf(cyl_image_buffer_size(fmt, W, H, 0));
     cyl_image img;
-    canvas_to_format(&c, CYL_FMT_YUYV, 0, 0, buf.data(), buf.size(), &img);
+    canvas_to_format(&c, fmt, 0, 0, buf.data(), buf.size(), &img);
     canvas_free(&c);
     return buf;
+}
+
+// Fraction of a frame's pixels that the table classifies (for the report).
+inline double coloured_fraction(const cyl_colortable &t, const std::vector<uint8_t> &yuyv)
+{
+    size_t n = 0;
+    for (size_t i = 0; i + 3 < yuyv.size(); i += 4) {
+        n += cyl_colortable_mask(&t, yuyv[i], yuyv[i + 1], yuyv[i + 3]) != 0;
+        n += cyl_colortable_mask(&t, yuyv[i + 2], yuyv[i + 1], yuyv[i + 3]) != 0;
+    }
+    return (double)n / (double)(yuyv.size() / 2);
 }
 
 inline double median(std::vector<double> v)
@@ -100,9 +141,10 @@ struct Setup {
     cyl_segment_params params = cyl_segment_params_default();
     std::vector<uint8_t> mem;
     cyl_segmentation seg{};
-    explicit Setup(int nframes, uint32_t max_runs = 40000, uint32_t max_blobs = 4096)
+    explicit Setup(int nframes, uint32_t max_runs = 40000, uint32_t max_blobs = 4096,
+                   FrameSet set = FrameSet::Typical)
     {
-        for (int i = 0; i < nframes; i++) frames.push_back(make_frame(1000 + (uint64_t)i));
+        for (int i = 0; i < nframes; i++) frames.push_back(make_frame(1000 + (uint64_t)i, set));
         make_table(&table);
         to_3d_table(table, &table3d);
         mem.resize(cyl_segment_mem_size(max_runs, max_blobs));

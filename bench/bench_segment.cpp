@@ -6,8 +6,12 @@
 // in one run. Prints a table and, last, a JSON line. Not a test.
 //
 //   bench_segment [--iterations N] [--frames F]       timing (medians)
-//   bench_segment --callgrind K [--3d]                only libcyl, K frames (for valgrind);
-//                                                     --3d: with the learned-form (3-D) table
+//   bench_segment --callgrind K [--3d] [--set S]      only libcyl, K frames (for valgrind);
+//                                                     --3d: with the learned-form (3-D) table;
+//                                                     --set typical|dense|speckle (bench_frames.hpp)
+// Beside the typical frames: the dense and speckle worst cases (ratios to a memcpy of the same
+// frames, in the same run), and large frames (2048x1536 and 3840x2160, YUYV and NV12: frames/s on
+// one core).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -32,20 +36,27 @@ using namespace bench;
 int main(int argc, char **argv)
 {
     int iterations = 1500, nframes = 16, callgrind = 0, use3d = 0;
+    FrameSet cg_set = FrameSet::Typical;
     for (int i = 1; i < argc; i++) {
         std::string a = argv[i];
         if (a == "--help" || a == "-h") {
-            std::printf("usage: bench_segment [--iterations N] [--frames F] [--callgrind K [--3d]]\n");
+            std::printf("usage: bench_segment [--iterations N] [--frames F] [--callgrind K [--3d] [--set S]]\n");
             return 0;
         } else if (a == "--iterations" && i + 1 < argc) iterations = std::atoi(argv[++i]);
         else if (a == "--frames" && i + 1 < argc) nframes = std::atoi(argv[++i]);
         else if (a == "--callgrind" && i + 1 < argc) callgrind = std::atoi(argv[++i]);
         else if (a == "--3d") use3d = 1;
+        else if (a == "--set" && i + 1 < argc) {
+            std::string v = argv[++i];
+            if (v == "dense") cg_set = FrameSet::Dense;
+            else if (v == "speckle") cg_set = FrameSet::Speckle;
+            else if (v != "typical") { std::fprintf(stderr, "bench_segment: --set typical|dense|speckle\n"); return 2; }
+        }
         else { std::fprintf(stderr, "bench_segment: unknown argument '%s' (see --help)\n", a.c_str()); return 2; }
     }
     if (iterations < 1 || nframes < 1) { std::fprintf(stderr, "bench_segment: counts must be >= 1\n"); return 2; }
 
-    static Setup set(nframes);  // static: the tables are 193 KiB each
+    static Setup set(nframes, 40000, 4096, callgrind > 0 ? cg_set : FrameSet::Typical);  // static: 193 KiB tables
     const std::vector<std::vector<uint8_t>> &frames = set.frames;
     const cyl_colortable &table = use3d ? set.table3d : set.table;
     const cyl_segment_params &params = set.params;
@@ -110,8 +121,69 @@ int main(int argc, char **argv)
     std::printf("%-52s %12.1f %9.2fx\n", "OpenCV cvtColor+2 inRange+2 connectedComponents", m_cv, m_cv / m_mem);
     std::printf("libcyl blobs/frame %.2f; libcyl is %.1fx faster than OpenCV (sink %lu)\n",
                 (double)cyl_blobs / iterations, m_cv / m_cyl, sink % 7);
+
+    // The worst cases: the same timing against a memcpy of the same frames, interleaved.
+    double worst = 0, set_ratio[3] = {m_cyl / m_mem, 0, 0}, set_frac[3] = {0, 0, 0};
+    for (int k = 1; k < 3; k++) {
+        const FrameSet fs = (FrameSet)k;
+        std::vector<std::vector<uint8_t>> fr;
+        for (int i = 0; i < nframes; i++) fr.push_back(make_frame(2000 + (uint64_t)i, fs));
+        std::vector<double> tc, tm;
+        unsigned long blobs = 0;
+        for (int i = 0; i < iterations / 3; i++) {
+            const std::vector<uint8_t> &f = fr[i % nframes];
+            double t0 = now_us();
+            std::memcpy(dst.data(), f.data(), f.size());
+            double t1 = now_us();
+            sink += dst[(size_t)i % dst.size()];
+            cyl_image img;
+            cyl_image_wrap(&img, CYL_FMT_YUYV, kW, kH, f.data(), 0);
+            double t2 = now_us();
+            cyl_segment(&table, &img, &params, &seg);
+            double t3 = now_us();
+            blobs += seg.n_blobs;
+            tm.push_back(t1 - t0);
+            tc.push_back(t3 - t2);
+        }
+        for (const auto &f : fr) set_frac[k] += coloured_fraction(table, f) / (double)fr.size();
+        set_ratio[k] = median(tc) / median(tm);
+        worst = std::max(worst, set_ratio[k]);
+        std::printf("%-52s %12.1f %9.2fx  (%.0f%% coloured, %.0f blobs/frame)\n",
+                    (std::string("libcyl on the ") + set_name(fs) + " set").c_str(), median(tc), set_ratio[k],
+                    100 * set_frac[k], (double)blobs / (double)(iterations / 3));
+    }
+    for (const auto &f : frames) set_frac[0] += coloured_fraction(table, f) / (double)frames.size();
+
+    // Large frames: frames/s of cyl_segment on one core.
+    struct Large { uint32_t w, h; cyl_pixfmt fmt; const char *name; double fps; };
+    Large large[] = {{2048, 1536, CYL_FMT_YUYV, "2048x1536 YUYV", 0}, {2048, 1536, CYL_FMT_NV12, "2048x1536 NV12", 0},
+                     {3840, 2160, CYL_FMT_YUYV, "3840x2160 YUYV", 0}, {3840, 2160, CYL_FMT_NV12, "3840x2160 NV12", 0}};
+    for (Large &L : large) {
+        const uint32_t max_runs = cyl_segment_max_runs(L.w, L.h, &params) / 8, max_blobs = 16384;
+        std::vector<uint8_t> mem(cyl_segment_mem_size(max_runs, max_blobs));
+        cyl_segmentation big{};
+        cyl_segmentation_init(&big, mem.data(), mem.size(), max_runs, max_blobs);
+        std::vector<std::vector<uint8_t>> fr;
+        for (int i = 0; i < 3; i++) fr.push_back(make_frame(3000 + (uint64_t)i, FrameSet::Typical, L.w, L.h, L.fmt));
+        std::vector<double> t;
+        for (int i = 0; i < std::max(9, iterations / 50); i++) {
+            cyl_image img;
+            cyl_image_wrap(&img, L.fmt, L.w, L.h, fr[i % 3].data(), 0);
+            double t0 = now_us();
+            cyl_segment(&table, &img, &params, &big);
+            t.push_back(now_us() - t0);
+        }
+        L.fps = 1e6 / median(t);
+        std::printf("%-52s %12.1f   %.0f frames/s on one core\n", (std::string("libcyl on ") + L.name).c_str(),
+                    median(t), L.fps);
+    }
     std::printf("{\"libcyl_us\": %.2f, \"memcpy_us\": %.2f, \"opencv_us\": %.2f, \"libcyl_over_memcpy\": %.3f, "
-                "\"opencv_over_libcyl\": %.2f, \"libcyl_3d_us\": %.2f, \"table3d_over_box\": %.3f}\n", m_cyl, m_mem, m_cv,
-                m_cyl / m_mem, m_cv / m_cyl, m_3d, m_3d / m_cyl);
+                "\"opencv_over_libcyl\": %.2f, \"libcyl_3d_us\": %.2f, \"table3d_over_box\": %.3f, "
+                "\"typical_coloured_frac\": %.3f, \"dense_libcyl_over_memcpy\": %.3f, \"dense_coloured_frac\": %.3f, "
+                "\"speckle_libcyl_over_memcpy\": %.3f, \"worst_libcyl_over_memcpy\": %.3f, "
+                "\"fps_2048x1536_yuyv\": %.1f, \"fps_2048x1536_nv12\": %.1f, \"fps_3840x2160_yuyv\": %.1f, "
+                "\"fps_3840x2160_nv12\": %.1f}\n",
+                m_cyl, m_mem, m_cv, m_cyl / m_mem, m_cv / m_cyl, m_3d, m_3d / m_cyl, set_frac[0], set_ratio[1], set_frac[1],
+                set_ratio[2], worst, large[0].fps, large[1].fps, large[2].fps, large[3].fps);
     return 0;
 }

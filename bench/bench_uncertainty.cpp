@@ -71,8 +71,9 @@ int main(int argc, char **argv)
                 "(%.2f us/blob) vs cyl_segment %.1f us/frame: %.1f%% (limit 10%%) [sink %g]\n",
                 mo, (double)nobs / iterations, mo / std::max(1.0, (double)nobs / iterations), ms,
                 100 * mo / ms, sink > 0 ? 1.0 : 0.0);
-    std::printf(", \"observe_us\": %.2f, \"observe_blobs_per_frame\": %.2f, \"observe_over_segment\": %.4f\n",
-                mo, (double)nobs / iterations, mo / ms);
+    std::printf(", \"observe_us\": %.2f, \"observe_blobs_per_frame\": %.2f, \"observe_us_per_blob\": %.3f, "
+                "\"observe_over_segment\": %.4f\n",
+                mo, (double)nobs / iterations, mo / std::max(1.0, (double)nobs / iterations), mo / ms);
     (void)nblobs;
     return 0;
 }

@@ -3,7 +3,8 @@
 # make bench: every benchmark in one run; each prints its table, and the last line is one JSON
 # object merging all their figures. Timing figures are medians and ratios against baselines
 # measured in the same run (memcpy, OpenCV); instruction counts come from callgrind.
-#   1. segmentation: libcyl vs memcpy vs an OpenCV pipeline, and instructions per pixel
+#   1. segmentation: libcyl vs memcpy vs an OpenCV pipeline, and instructions per pixel, on the
+#      typical frames and the dense and speckle worst cases; large frames (2048x1536, 3840x2160)
 #   2. uncertainty: cyl_observe (noise estimation + camera model) vs cyl_segment per frame
 #   3. end-to-end replay of recorded 640x480 YUYV logs through `cyl detect` (frames/s, peak RSS
 #      of a 1,000- and a 10,000-frame log; ~6 GB of temporary disk in build/bench)
@@ -19,6 +20,14 @@ valgrind --tool=callgrind --callgrind-out-file="$cg/cg.out" --toggle-collect=cyl
 ir=$(awk '/^totals:/{print $2}' "$cg/cg.out")
 ipp=$(awk -v ir="$ir" -v k=$K 'BEGIN{printf "%.2f", ir / (k * 640 * 480)}')
 echo "callgrind: cyl_segment $ir instructions over $K frames = $ipp instructions per pixel"
+# the worst-case sets too
+for set in dense speckle; do
+  valgrind --tool=callgrind --callgrind-out-file="$cg/$set.out" --toggle-collect=cyl_segment \
+    "$B/bench_segment" --callgrind $K --set $set >/dev/null 2>"$cg/log"
+  v=$(awk -v ir="$(awk '/^totals:/{print $2}' "$cg/$set.out")" -v k=$K 'BEGIN{printf "%.2f", ir / (k * 640 * 480)}')
+  echo "callgrind: cyl_segment on the $set set = $v instructions per pixel"
+  eval "ipp_$set=$v"
+done
 rm -rf "$cg"
 echo
 unc=$("$B/bench_uncertainty")
@@ -27,4 +36,4 @@ echo
 rep=$("$B/bench_replay" "$B/cyl" calib_data/synthetic.cylt)
 echo "$rep" | sed '$d'
 echo
-echo "{$(strip "$(echo "$seg" | tail -1)"), \"instr_per_pixel\": $ipp$(echo "$unc" | tail -1), $(strip "$(echo "$rep" | tail -1)")}"
+echo "{$(strip "$(echo "$seg" | tail -1)"), \"instr_per_pixel\": $ipp, \"instr_per_pixel_dense\": $ipp_dense, \"instr_per_pixel_speckle\": $ipp_speckle$(echo "$unc" | tail -1), $(strip "$(echo "$rep" | tail -1)")}"
