@@ -6,6 +6,8 @@
 // in one run. Prints a table and, last, a JSON line. Not a test.
 //
 //   bench_segment [--iterations N] [--frames F]       timing (medians)
+//   bench_segment --real LIST TABLE [--iterations N]  real images (one path a line), converted to
+//                                                     YUYV, with a learned table: libcyl vs memcpy
 //   bench_segment --callgrind K [--3d] [--set S]      only libcyl, K frames (for valgrind);
 //                                                     --3d: with the learned-form (3-D) table;
 //                                                     --set typical|dense|speckle (bench_frames.hpp)
@@ -20,7 +22,10 @@
 #include <string>
 #include <vector>
 
+#include <fstream>
+
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 extern "C" {
@@ -33,10 +38,88 @@ extern "C" {
 
 using namespace bench;
 
+namespace {
+
+// BGR image -> YUYV (BT.601 as OpenCV's COLOR_BGR2YUV, each pair's chroma averaged), even width.
+std::vector<uint8_t> bgr_to_yuyv(const cv::Mat &bgr, uint32_t *w, uint32_t *h)
+{
+    cv::Mat yuv;
+    cv::cvtColor(bgr, yuv, cv::COLOR_BGR2YUV);
+    *w = (uint32_t)(yuv.cols & ~1);
+    *h = (uint32_t)yuv.rows;
+    std::vector<uint8_t> out((size_t)*w * *h * 2);
+    for (uint32_t y = 0; y < *h; y++)
+        for (uint32_t x = 0; x < *w; x += 2) {
+            const cv::Vec3b a = yuv.at<cv::Vec3b>((int)y, (int)x), b = yuv.at<cv::Vec3b>((int)y, (int)x + 1);
+            uint8_t *d = &out[((size_t)y * *w + x) * 2];
+            d[0] = a[0];
+            d[1] = (uint8_t)((a[1] + b[1] + 1) / 2);
+            d[2] = b[0];
+            d[3] = (uint8_t)((a[2] + b[2] + 1) / 2);
+        }
+    return out;
+}
+
+// --real LIST TABLE: each image's cyl_segment against a memcpy of the same frame; medians of the
+// per-image ratios. Last line JSON.
+int bench_real(const std::string &list, const std::string &table_path, int iterations)
+{
+    std::ifstream lf(list);
+    if (!lf) { std::fprintf(stderr, "bench_segment: %s: cannot open\n", list.c_str()); return 1; }
+    std::ifstream tf(table_path, std::ios::binary);
+    std::vector<uint8_t> tb((std::istreambuf_iterator<char>(tf)), std::istreambuf_iterator<char>());
+    static cyl_colortable table;
+    if (tb.empty() || cyl_colortable_load(&table, tb.data(), tb.size()) != CYL_OK) {
+        std::fprintf(stderr, "bench_segment: %s: not a colour table\n", table_path.c_str());
+        return 1;
+    }
+    std::vector<double> ratios, mpx;
+    double coloured = 0;
+    std::string path;
+    while (std::getline(lf, path)) {
+        if (path.empty() || path[0] == '#') continue;
+        cv::Mat bgr = cv::imread(path, cv::IMREAD_COLOR);
+        if (bgr.empty()) { std::fprintf(stderr, "bench_segment: %s: cannot read\n", path.c_str()); return 1; }
+        uint32_t w, h;
+        std::vector<uint8_t> f = bgr_to_yuyv(bgr, &w, &h), dst(f.size());
+        cyl_segment_params params = cyl_segment_params_default();
+        const uint32_t max_runs = cyl_segment_max_runs(w, h, &params), max_blobs = 65535;
+        std::vector<uint8_t> mem(cyl_segment_mem_size(max_runs, max_blobs));
+        cyl_segmentation seg{};
+        cyl_segmentation_init(&seg, mem.data(), mem.size(), max_runs, max_blobs);
+        cyl_image img;
+        cyl_image_wrap(&img, CYL_FMT_YUYV, w, h, f.data(), 0);
+        std::vector<double> tc, tm;
+        for (int i = 0; i < iterations; i++) {
+            double t0 = now_us();
+            std::memcpy(dst.data(), f.data(), f.size());
+            double t1 = now_us();
+            cyl_segment(&table, &img, &params, &seg);
+            double t2 = now_us();
+            tm.push_back(t1 - t0);
+            tc.push_back(t2 - t1);
+        }
+        ratios.push_back(median(tc) / median(tm));
+        mpx.push_back(1e-6 * w * h / (median(tc) * 1e-6));
+        coloured += coloured_fraction(table, f);
+    }
+    if (ratios.empty()) { std::fprintf(stderr, "bench_segment: %s: no images\n", list.c_str()); return 1; }
+    std::printf("real images (%s): %zu images, libcyl %.2fx memcpy (median of the per-image ratios; %.2f-%.2f), "
+                "%.0f Mpx/s, %.1f%% of pixels coloured\n", list.c_str(), ratios.size(), median(ratios),
+                *std::min_element(ratios.begin(), ratios.end()), *std::max_element(ratios.begin(), ratios.end()),
+                median(mpx), 100 * coloured / (double)ratios.size());
+    std::printf("{\"real_images\": %zu, \"real_libcyl_over_memcpy\": %.3f, \"real_mpx_per_s\": %.1f}\n", ratios.size(),
+                median(ratios), median(mpx));
+    return 0;
+}
+
+} // namespace
+
 int main(int argc, char **argv)
 {
     int iterations = 1500, nframes = 16, callgrind = 0, use3d = 0;
     FrameSet cg_set = FrameSet::Typical;
+    std::string real_list, real_table;
     for (int i = 1; i < argc; i++) {
         std::string a = argv[i];
         if (a == "--help" || a == "-h") {
@@ -46,6 +129,7 @@ int main(int argc, char **argv)
         else if (a == "--frames" && i + 1 < argc) nframes = std::atoi(argv[++i]);
         else if (a == "--callgrind" && i + 1 < argc) callgrind = std::atoi(argv[++i]);
         else if (a == "--3d") use3d = 1;
+        else if (a == "--real" && i + 2 < argc) { real_list = argv[++i]; real_table = argv[++i]; }
         else if (a == "--set" && i + 1 < argc) {
             std::string v = argv[++i];
             if (v == "dense") cg_set = FrameSet::Dense;
@@ -55,6 +139,7 @@ int main(int argc, char **argv)
         else { std::fprintf(stderr, "bench_segment: unknown argument '%s' (see --help)\n", a.c_str()); return 2; }
     }
     if (iterations < 1 || nframes < 1) { std::fprintf(stderr, "bench_segment: counts must be >= 1\n"); return 2; }
+    if (!real_list.empty()) return bench_real(real_list, real_table, std::min(iterations, 60));
 
     static Setup set(nframes, 40000, 4096, callgrind > 0 ? cg_set : FrameSet::Typical);  // static: 193 KiB tables
     const std::vector<std::vector<uint8_t>> &frames = set.frames;

@@ -5,6 +5,8 @@
 # measured in the same run (memcpy, OpenCV); instruction counts come from callgrind.
 #   1. segmentation: libcyl vs memcpy vs an OpenCV pipeline, and instructions per pixel, on the
 #      typical frames and the dense and speckle worst cases; large frames (2048x1536, 3840x2160)
+#      and, when the shared data are there, real images (RoboCup ball, FRC cones and cubes) with
+#      the tables learned on their training splits
 #   2. uncertainty: cyl_observe (noise estimation + camera model) vs cyl_segment per frame
 #   3. end-to-end replay of recorded 640x480 YUYV logs through `cyl detect` (frames/s, peak RSS
 #      of a 1,000- and a 10,000-frame log; ~6 GB of temporary disk in build/bench)
@@ -36,4 +38,21 @@ echo
 rep=$("$B/bench_replay" "$B/cyl" calib_data/synthetic.cylt)
 echo "$rep" | sed '$d'
 echo
-echo "{$(strip "$(echo "$seg" | tail -1)"), \"instr_per_pixel\": $ipp, \"instr_per_pixel_dense\": $ipp_dense, \"instr_per_pixel_speckle\": $ipp_speckle$(echo "$unc" | tail -1), $(strip "$(echo "$rep" | tail -1)")}"
+# Real images when the shared data are there (SHARED, default ../shared): the colour tables
+# `make realeval` learns on each set's training split, timed on its test split.
+SHARED=${SHARED:-../shared}
+real=""
+if [ -d "$SHARED/data/real" ] && [ -x "$B/cyl-train" ] && [ -x "$B/cyl-score" ]; then
+  python3 scripts/realeval.py --shared "$SHARED" --build "$B" --out "$B/bench/real" >"$B/bench/realeval.log" 2>&1 ||
+    { echo "real images: realeval failed (see $B/bench/realeval.log)"; exit 1; }
+  for n in ball frc; do
+    r=$("$B/bench_segment" --real "$B/bench/real/$n-test.list" "$B/bench/real/$n.cylt" --iterations 30)
+    echo "$r" | sed '$d'
+    j=$(echo "$r" | tail -1 | sed "s/\"real_/\"real_${n}_/g")
+    real="$real, $(strip "$j")"
+  done
+else
+  echo "real images: not measured ($SHARED/data/real absent, or cyl-train/cyl-score not built)"
+fi
+echo
+echo "{$(strip "$(echo "$seg" | tail -1)")$real, \"instr_per_pixel\": $ipp, \"instr_per_pixel_dense\": $ipp_dense, \"instr_per_pixel_speckle\": $ipp_speckle$(echo "$unc" | tail -1), $(strip "$(echo "$rep" | tail -1)")}"

@@ -185,7 +185,7 @@ def main():
             return 1
         sets = splits(a.shared)
     tmp = None
-    out = a.out
+    out = os.path.abspath(a.out) if a.out else None   # list files name images relative to their folder
     if out is None:
         tmp = tempfile.TemporaryDirectory()
         out = tmp.name
