@@ -18,6 +18,8 @@ from __future__ import annotations
 import json
 from typing import Dict
 
+from .output import OutputFile
+
 NUM = {"type": "number"}
 
 
@@ -94,8 +96,7 @@ def convert(log: str, out: str) -> Dict[str, int]:
         raise ObsMcapError(f"{log}: empty")
     t0 = next((r["t"] for r in recs if "t" in r), 0.0)
     counts = {k: 0 for k in SCHEMAS}
-    tmp = out + ".part"
-    with open(tmp, "wb") as f:
+    with OutputFile(out) as f:   # .part renamed at the end, device nodes and FIFOs written in place
         w = Writer(f)
         w.start(profile="", library="libcyl cyl-robotlog")
         chan = {}
@@ -108,6 +109,4 @@ def convert(log: str, out: str) -> Dict[str, int]:
                           data=json.dumps(r, separators=(",", ":")).encode())
             counts[r["type"]] += 1
         w.finish()
-    import os
-    os.replace(tmp, out)
     return counts

@@ -8,10 +8,11 @@ and truth landmarks as belonging to the frame whose sequence number they carry.
 """
 from __future__ import annotations
 
-import os
 import struct
 from dataclasses import dataclass, field
 from typing import Iterator, List, Optional, Tuple
+
+from .output import OutputError, OutputFile
 
 MAGIC = b"CYLRAW\0\0"
 VERSION = 1
@@ -135,8 +136,8 @@ class Reader:
 
 
 class Writer:
-    """Write a raw log to `path` + '.part', renamed over `path` by close() (only over a regular
-    file: a device node or FIFO is written in place, as the C++ tools do)."""
+    """Write a raw log to `path` (cyl.output.OutputFile: `path`.part renamed by close() over a
+    regular file; a device node or FIFO written in place, as the C++ tools do)."""
 
     def __init__(self, path: str, info: StreamInfo):
         self.path = path
@@ -147,14 +148,11 @@ class Writer:
         if info.frame_bytes != want:
             raise RawLogError(f"{path}: {info.fourcc} {info.width}x{info.height} stride {info.stride} frames are "
                               f"{want} bytes, not {info.frame_bytes}")
-        self._in_place = os.path.exists(path) and not os.path.isfile(path) and not os.path.islink(path)
-        if os.path.islink(path) and not os.path.exists(path):
-            raise RawLogError(f"{path}: a dangling symbolic link; not written")
-        if os.path.isdir(path):
-            raise RawLogError(f"{path}: is a directory")
-        self._target = os.path.realpath(path) if os.path.islink(path) else path
-        self._tmp = self._target if self._in_place else self._target + ".part"
-        self._f = open(self._tmp, "wb")
+        try:
+            self._out = OutputFile(path)
+        except OutputError as e:
+            raise RawLogError(str(e)) from None
+        self._f = self._out.f
         src = info.source.encode("utf-8")[:23]
         self._f.write(FILE_HEADER.pack(MAGIC, VERSION, HEADER_SIZE, fourcc(info.fourcc), info.width, info.height,
                                        info.stride, info.frame_bytes, info.flags, src.ljust(24, b"\0")))
@@ -168,20 +166,11 @@ class Writer:
         self.records += 1
 
     def close(self):
-        if self._f is None:
-            return
-        self._f.close()
-        self._f = None
-        if not self._in_place:
-            os.replace(self._tmp, self._target)
+        self._out.close()
 
     def abort(self):
         """Stop without replacing the target (the partial file is removed)."""
-        if self._f is not None:
-            self._f.close()
-            self._f = None
-            if not self._in_place:
-                os.unlink(self._tmp)
+        self._out.abort()
 
     def __enter__(self):
         return self

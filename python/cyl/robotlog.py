@@ -27,6 +27,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from . import rawlog
+from .output import OutputError, OutputFile
 
 
 class RobotLogError(ValueError):
@@ -529,7 +530,7 @@ def write_camera_info_yaml(path: str, ci):
             f"camera_matrix:\n  rows: 3\n  cols: 3\n  data: {fmt(K)}\n"
             f"distortion_model: {ci.distortion_model or 'plumb_bob'}\n"
             f"distortion_coefficients:\n  rows: 1\n  cols: {len(D)}\n  data: {fmt(D)}\n")
-    with open(path, "w") as f:
+    with OutputFile(path, "w") as f:
         f.write(text)
 
 
@@ -590,7 +591,7 @@ TF_STATIC_LINK = (0.05, -0.02, 0.1)    # base_footprint -> base_link in write_ba
 
 def write_bag(raw: str, out: str, storage: str, camera=None, jpeg: bool = False, classes: Sequence[str] = (),
               jpeg_quality: int = 95, time_offset_ns: int = 1_000_000_000, topics=None,
-              progress=None, tf: bool = False) -> Dict[str, int]:
+              tf: bool = False) -> Dict[str, int]:
     """A raw log as a bag: images (sensor_msgs/Image in the log's YUV layout, or CompressedImage
     JPEG), camera_info (from `camera`, a cyl.Camera), the odometry as nav_msgs/Odometry (the pose
     integrated from the increments, each increment's covariance as twist covariance over the frame
@@ -704,8 +705,6 @@ def write_bag(raw: str, out: str, storage: str, camera=None, jpeg: bool = False,
                         for a, v in (("k", K), ("d", D), ("p", P), ("r", R)):
                             setattr(ci, a if hasattr(ci, a) else a.upper(), v)
                         put("info", rec.t_ns, ci, "sensor_msgs/msg/CameraInfo")
-                    if progress:
-                        progress(r._f.tell(), None)
                 elif rec.type == rawlog.ODOMETRY:
                     d, c6 = rec.odometry()
                     pose = compose(pose, d)
@@ -951,11 +950,11 @@ def main(argv=None) -> int:
             for line in rep.lines():
                 print(f"cyl-robotlog: {line}", file=sys.stderr)
             print(f"cyl-robotlog: wrote {args.out}", file=sys.stderr)
-    except (RobotLogError, rawlog.RawLogError, ValueError) as e:
+    except (RobotLogError, rawlog.RawLogError, OutputError, ValueError) as e:
         print(f"cyl-robotlog: error: {e}", file=sys.stderr)
         return 1
     except OSError as e:
-        print(f"cyl-robotlog: error: {e.filename or ''}: {e.strerror}", file=sys.stderr)
+        print(f"cyl-robotlog: error: {e.filename or args.out}: {e.strerror}", file=sys.stderr)
         return 1
     return 0
 

@@ -361,3 +361,32 @@ def test_odometry_from_a_tf_chain(tmp_path, drive, storage):
     assert r.returncode == 1
     assert "no transform chain from 'odom' to 'base_lnk' (frames in /tf and /tf_static: base_footprint, base_link, odom)" \
         in r.stderr, r.stderr
+
+
+@needs_tools
+@pytest.mark.skipif(os.geteuid() != 0, reason="mknod needs root")
+def test_writers_leave_device_nodes_and_fifos_alone(tmp_path, drive):
+    """As the C++ tools: a character device and a FIFO are written in place, never replaced."""
+    import stat
+    import threading
+    dev, fifo = tmp_path / "null", tmp_path / "fifo"
+    os.mknod(dev, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+    os.mkfifo(fifo)
+    log = str(tmp_path / "o.jsonl")
+    detect(drive, log)
+    r = cli("obs-to-mcap", log, "-o", str(dev))
+    assert r.returncode == 0, r.stderr
+    r = cli("merge-odom-csv", drive, str(tmp_path / "none.csv"), "-o", str(dev))   # fails: nothing written
+    assert r.returncode == 1
+    bag = str(tmp_path / "b")
+    assert cli("write-bag", drive, "-o", bag).returncode == 0
+    sink = []
+    reader = threading.Thread(target=lambda: sink.append(len(open(fifo, "rb").read())))
+    reader.start()
+    for out in (str(dev), str(fifo)):
+        r = cli("import-bag", bag, "-o", out, *TOPICS)
+        assert r.returncode == 0, r.stderr
+    reader.join(30)
+    assert stat.S_ISCHR(os.stat(dev).st_mode) and stat.S_ISFIFO(os.stat(fifo).st_mode)
+    assert sink and sink[0] > 24 * 614400              # the raw log went through the FIFO
+    assert not list(tmp_path.glob("*.part"))

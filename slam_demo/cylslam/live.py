@@ -63,17 +63,17 @@ class LiveView:
             if os.path.exists(p):
                 self.rec.log("camera/overlay", rr.EncodedImage(path=p))
         if lms_init and (i % self.every == 0 or used):
-            import gtsam
+            from .backend import L     # the back end's landmark keys, not a second definition
             pts, ells = [], []
             for j in range(len(lms_init)):
                 try:
-                    pt = isam.calculateEstimatePoint2(gtsam.symbol("l", j))
+                    pt = isam.calculateEstimatePoint2(L(j))
                 except (RuntimeError, IndexError):
                     continue              # not yet in the solver (added at its next update)
                 pts.append([float(pt[0]), float(pt[1])])
                 if i % self.every == 0:
                     try:
-                        c = isam.marginalCovariance(gtsam.symbol("l", j))
+                        c = isam.marginalCovariance(L(j))
                         ells.append(ellipse_points(pts[-1], c).tolist())
                     except (RuntimeError, IndexError):
                         pass
