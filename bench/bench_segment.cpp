@@ -8,9 +8,13 @@
 //   bench_segment [--iterations N] [--frames F]       timing (medians)
 //   bench_segment --real LIST TABLE [--iterations N]  real images (one path a line), converted to
 //                                                     YUYV, with a learned table: libcyl vs memcpy
-//   bench_segment --callgrind K [--3d] [--set S]      only libcyl, K frames (for valgrind);
+//   bench_segment --callgrind K [--3d] [--set S] [--scalar]
+//                                                     only libcyl, K frames (for valgrind);
 //                                                     --3d: with the learned-form (3-D) table;
-//                                                     --set typical|dense|speckle (bench_frames.hpp)
+//                                                     --set typical|dense|speckle (bench_frames.hpp);
+//                                                     --scalar: the scalar reference path
+// libcyl is timed on its vector path (cyl_segment_vector_path()) and on the scalar reference path,
+// and the two are checked bit-identical on every frame of every set (simd_bit_identical).
 // Beside the typical frames: the dense and speckle worst cases (ratios to a memcpy of the same
 // frames, in the same run), and large frames (2048x1536 and 3840x2160, YUYV and NV12: frames/s on
 // one core).
@@ -117,18 +121,20 @@ int bench_real(const std::string &list, const std::string &table_path, int itera
 
 int main(int argc, char **argv)
 {
-    int iterations = 1500, nframes = 16, callgrind = 0, use3d = 0;
+    int iterations = 1500, nframes = 16, callgrind = 0, use3d = 0, scalar = 0;
     FrameSet cg_set = FrameSet::Typical;
     std::string real_list, real_table;
     for (int i = 1; i < argc; i++) {
         std::string a = argv[i];
         if (a == "--help" || a == "-h") {
-            std::printf("usage: bench_segment [--iterations N] [--frames F] [--callgrind K [--3d] [--set S]]\n");
+            std::printf("usage: bench_segment [--iterations N] [--frames F] [--callgrind K [--3d] [--set S] [--scalar]]\n"
+                        "       bench_segment --real LIST TABLE [--iterations N]\n");
             return 0;
         } else if (a == "--iterations" && i + 1 < argc) iterations = std::atoi(argv[++i]);
         else if (a == "--frames" && i + 1 < argc) nframes = std::atoi(argv[++i]);
         else if (a == "--callgrind" && i + 1 < argc) callgrind = std::atoi(argv[++i]);
         else if (a == "--3d") use3d = 1;
+        else if (a == "--scalar") scalar = 1;
         else if (a == "--real" && i + 2 < argc) { real_list = argv[++i]; real_table = argv[++i]; }
         else if (a == "--set" && i + 1 < argc) {
             std::string v = argv[++i];
@@ -146,13 +152,15 @@ int main(int argc, char **argv)
     const cyl_colortable &table = use3d ? set.table3d : set.table;
     const cyl_segment_params &params = set.params;
     cyl_segmentation &seg = set.seg;
+    cyl_segment_params scalar_params = params;
+    scalar_params.scalar_only = 1;
 
     if (callgrind > 0) {
         unsigned long blobs = 0;
         for (int i = 0; i < callgrind; i++) {
             cyl_image img;
             cyl_image_wrap(&img, CYL_FMT_YUYV, kW, kH, frames[i % nframes].data(), 0);
-            cyl_segment(&table, &img, &params, &seg);
+            cyl_segment(&table, &img, scalar ? &scalar_params : &params, &seg);
             blobs += seg.n_blobs;
         }
         std::printf("frames %d pixels_per_frame %u blobs %lu\n", callgrind, kW * kH, blobs);
@@ -164,7 +172,7 @@ int main(int argc, char **argv)
     cv::Mat bgr, mask, labels, stats, centroids;
     const cv::Scalar lo[2] = {cv::Scalar(0, 90, 200), cv::Scalar(60, 150, 0)};
     const cv::Scalar hi[2] = {cv::Scalar(120, 190, 255), cv::Scalar(170, 255, 120)};
-    std::vector<double> t_cyl, t_mem, t_cv, t_3d;
+    std::vector<double> t_cyl, t_mem, t_cv, t_3d, t_scalar;
     unsigned long sink = 0, cv_blobs = 0, cyl_blobs = 0;
     for (int i = 0; i < iterations; i++) {
         const std::vector<uint8_t> &f = frames[i % nframes];
@@ -181,6 +189,9 @@ int main(int argc, char **argv)
         double t6 = now_us();
         cyl_segment(&set.table3d, &img, &params, &seg);
         double t7 = now_us();
+        cyl_segment(&table, &img, &scalar_params, &seg);
+        double t8 = now_us();
+        t_scalar.push_back(t8 - t7);
         t_mem.push_back(t1 - t0);
         t_cyl.push_back(t3 - t2);
         t_3d.push_back(t7 - t6);
@@ -196,25 +207,53 @@ int main(int argc, char **argv)
             t_cv.push_back(t5 - t4);
         }
     }
-    double m_cyl = median(t_cyl), m_mem = median(t_mem), m_cv = median(t_cv), m_3d = median(t_3d);
+    double m_cyl = median(t_cyl), m_mem = median(t_mem), m_cv = median(t_cv), m_3d = median(t_3d),
+           m_scalar = median(t_scalar);
+    // the vector path against the scalar reference, bit for bit, on every frame of every set
+    const uint32_t cmp_runs = cyl_segment_max_runs(kW, kH, &params), cmp_blobs = 65535;
+    std::vector<uint8_t> cmp_mem(cyl_segment_mem_size(cmp_runs, cmp_blobs));
+    cyl_segmentation cmp{};
+    cyl_segmentation_init(&cmp, cmp_mem.data(), cmp_mem.size(), cmp_runs, cmp_blobs);
+    int identical = 1, compared = 0;
+    auto same = [&](const cyl_colortable &tb, const cyl_image &img, cyl_segmentation &s) {
+        cyl_segment(&tb, &img, &params, &s);
+        cyl_segment(&tb, &img, &scalar_params, &cmp);
+        compared++;
+        return s.n_runs == cmp.n_runs && s.n_blobs == cmp.n_blobs &&
+               std::memcmp(s.runs, cmp.runs, sizeof(cyl_run) * s.n_runs) == 0 &&
+               std::memcmp(s.blobs, cmp.blobs, sizeof(cyl_blob) * s.n_blobs) == 0;
+    };
+    for (const auto &f : frames) {
+        cyl_image img;
+        cyl_image_wrap(&img, CYL_FMT_YUYV, kW, kH, f.data(), 0);
+        identical &= same(table, img, seg) && same(set.table3d, img, seg);
+    }
     std::printf("640x480 YUYV, %d distinct frames, %d iterations (OpenCV %zu), one thread\n", nframes,
                 iterations, t_cv.size());
     std::printf("%-52s %12s %10s\n", "pipeline", "median us", "ratio");
     std::printf("%-52s %12.1f %10s\n", "memcpy of the frame (floor)", m_mem, "1.00x");
-    std::printf("%-52s %12.1f %9.2fx\n", "libcyl classify+RLE+blobs (cyl_segment)", m_cyl, m_cyl / m_mem);
+    std::printf("%-52s %12.1f %9.2fx\n", (std::string("libcyl classify+RLE+blobs, ") + cyl_segment_vector_path() + " path").c_str(),
+                m_cyl, m_cyl / m_mem);
+    std::printf("%-52s %12.1f %9.2fx\n", "libcyl, scalar reference path", m_scalar, m_scalar / m_mem);
     std::printf("%-52s %12.1f %9.2fx\n", "libcyl, same classes as a learned 3-D table", m_3d, m_3d / m_mem);
     std::printf("%-52s %12.1f %9.2fx\n", "OpenCV cvtColor+2 inRange+2 connectedComponents", m_cv, m_cv / m_mem);
     std::printf("libcyl blobs/frame %.2f; libcyl is %.1fx faster than OpenCV (sink %lu)\n",
                 (double)cyl_blobs / iterations, m_cv / m_cyl, sink % 7);
 
     // The worst cases: the same timing against a memcpy of the same frames, interleaved.
-    double worst = 0, set_ratio[3] = {m_cyl / m_mem, 0, 0}, set_frac[3] = {0, 0, 0};
+    double worst = 0, set_ratio[3] = {m_cyl / m_mem, 0, 0}, set_frac[3] = {0, 0, 0},
+           scalar_ratio[3] = {m_scalar / m_mem, 0, 0};
     for (int k = 1; k < 3; k++) {
         const FrameSet fs = (FrameSet)k;
         std::vector<std::vector<uint8_t>> fr;
         for (int i = 0; i < nframes; i++) fr.push_back(make_frame(2000 + (uint64_t)i, fs));
-        std::vector<double> tc, tm;
+        std::vector<double> tc, tm, ts;
         unsigned long blobs = 0;
+        for (const auto &f : fr) {
+            cyl_image img;
+            cyl_image_wrap(&img, CYL_FMT_YUYV, kW, kH, f.data(), 0);
+            identical &= same(table, img, seg) && same(set.table3d, img, seg);
+        }
         for (int i = 0; i < iterations / 3; i++) {
             const std::vector<uint8_t> &f = fr[i % nframes];
             double t0 = now_us();
@@ -227,15 +266,19 @@ int main(int argc, char **argv)
             cyl_segment(&table, &img, &params, &seg);
             double t3 = now_us();
             blobs += seg.n_blobs;
+            cyl_segment(&table, &img, &scalar_params, &seg);
+            double t4 = now_us();
             tm.push_back(t1 - t0);
             tc.push_back(t3 - t2);
+            ts.push_back(t4 - t3);
         }
         for (const auto &f : fr) set_frac[k] += coloured_fraction(table, f) / (double)fr.size();
         set_ratio[k] = median(tc) / median(tm);
+        scalar_ratio[k] = median(ts) / median(tm);
         worst = std::max(worst, set_ratio[k]);
-        std::printf("%-52s %12.1f %9.2fx  (%.0f%% coloured, %.0f blobs/frame)\n",
+        std::printf("%-52s %12.1f %9.2fx  (%.0f%% coloured, %.0f blobs/frame; scalar path %.2fx)\n",
                     (std::string("libcyl on the ") + set_name(fs) + " set").c_str(), median(tc), set_ratio[k],
-                    100 * set_frac[k], (double)blobs / (double)(iterations / 3));
+                    100 * set_frac[k], (double)blobs / (double)(iterations / 3), scalar_ratio[k]);
     }
     for (const auto &f : frames) set_frac[0] += coloured_fraction(table, f) / (double)frames.size();
 
@@ -258,6 +301,15 @@ int main(int argc, char **argv)
             cyl_segment(&table, &img, &params, &big);
             t.push_back(now_us() - t0);
         }
+        for (const auto &f : fr) {
+            cyl_image img;
+            cyl_image_wrap(&img, L.fmt, L.w, L.h, f.data(), 0);
+            const uint32_t n0 = (cyl_segment(&table, &img, &params, &big), big.n_runs);
+            std::vector<cyl_run> r0(big.runs, big.runs + n0);
+            cyl_segment(&table, &img, &scalar_params, &big);
+            identical &= big.n_runs == n0 && std::memcmp(r0.data(), big.runs, sizeof(cyl_run) * n0) == 0;
+            compared++;
+        }
         L.fps = 1e6 / median(t);
         std::printf("%-52s %12.1f   %.0f frames/s on one core\n", (std::string("libcyl on ") + L.name).c_str(),
                     median(t), L.fps);
@@ -267,8 +319,10 @@ int main(int argc, char **argv)
                 "\"typical_coloured_frac\": %.3f, \"dense_libcyl_over_memcpy\": %.3f, \"dense_coloured_frac\": %.3f, "
                 "\"speckle_libcyl_over_memcpy\": %.3f, \"worst_libcyl_over_memcpy\": %.3f, "
                 "\"fps_2048x1536_yuyv\": %.1f, \"fps_2048x1536_nv12\": %.1f, \"fps_3840x2160_yuyv\": %.1f, "
-                "\"fps_3840x2160_nv12\": %.1f}\n",
+                "\"fps_3840x2160_nv12\": %.1f, \"vector_path\": \"%s\", \"scalar_libcyl_over_memcpy\": %.3f, "
+                "\"scalar_worst_libcyl_over_memcpy\": %.3f, \"simd_bit_identical\": %s, \"simd_frames_compared\": %d}\n",
                 m_cyl, m_mem, m_cv, m_cyl / m_mem, m_cv / m_cyl, m_3d, m_3d / m_cyl, set_frac[0], set_ratio[1], set_frac[1],
-                set_ratio[2], worst, large[0].fps, large[1].fps, large[2].fps, large[3].fps);
+                set_ratio[2], worst, large[0].fps, large[1].fps, large[2].fps, large[3].fps, cyl_segment_vector_path(),
+                scalar_ratio[0], std::max(scalar_ratio[1], scalar_ratio[2]), identical ? "true" : "false", compared);
     return 0;
 }

@@ -3,7 +3,8 @@
 # make bench: every benchmark in one run; each prints its table, and the last line is one JSON
 # object merging all their figures. Timing figures are medians and ratios against baselines
 # measured in the same run (memcpy, OpenCV); instruction counts come from callgrind.
-#   1. segmentation: libcyl vs memcpy vs an OpenCV pipeline, and instructions per pixel, on the
+#   1. segmentation: libcyl (vector and scalar paths, checked bit-identical) vs memcpy vs an
+#      OpenCV pipeline, and instructions per pixel, on the
 #      typical frames and the dense and speckle worst cases; large frames (2048x1536, 3840x2160)
 #      and, when the shared data are there, real images (RoboCup ball, FRC cones and cubes) with
 #      the tables learned on their training splits
@@ -21,7 +22,11 @@ valgrind --tool=callgrind --callgrind-out-file="$cg/cg.out" --toggle-collect=cyl
   "$B/bench_segment" --callgrind $K >/dev/null 2>"$cg/log"
 ir=$(awk '/^totals:/{print $2}' "$cg/cg.out")
 ipp=$(awk -v ir="$ir" -v k=$K 'BEGIN{printf "%.2f", ir / (k * 640 * 480)}')
-echo "callgrind: cyl_segment $ir instructions over $K frames = $ipp instructions per pixel"
+echo "callgrind: cyl_segment $ir instructions over $K frames = $ipp instructions per pixel (vector path)"
+valgrind --tool=callgrind --callgrind-out-file="$cg/scalar.out" --toggle-collect=cyl_segment \
+  "$B/bench_segment" --callgrind $K --scalar >/dev/null 2>"$cg/log"
+ipp_scalar=$(awk -v ir="$(awk '/^totals:/{print $2}' "$cg/scalar.out")" -v k=$K 'BEGIN{printf "%.2f", ir / (k * 640 * 480)}')
+echo "callgrind: cyl_segment on the scalar reference path = $ipp_scalar instructions per pixel"
 # the worst-case sets too
 for set in dense speckle; do
   valgrind --tool=callgrind --callgrind-out-file="$cg/$set.out" --toggle-collect=cyl_segment \
@@ -55,4 +60,4 @@ else
   echo "real images: not measured ($SHARED/data/real absent, or cyl-train/cyl-score not built)"
 fi
 echo
-echo "{$(strip "$(echo "$seg" | tail -1)")$real, \"instr_per_pixel\": $ipp, \"instr_per_pixel_dense\": $ipp_dense, \"instr_per_pixel_speckle\": $ipp_speckle$(echo "$unc" | tail -1), $(strip "$(echo "$rep" | tail -1)")}"
+echo "{$(strip "$(echo "$seg" | tail -1)")$real, \"instr_per_pixel\": $ipp, \"instr_per_pixel_scalar\": $ipp_scalar, \"instr_per_pixel_dense\": $ipp_dense, \"instr_per_pixel_speckle\": $ipp_speckle$(echo "$unc" | tail -1), $(strip "$(echo "$rep" | tail -1)")}"

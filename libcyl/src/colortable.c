@@ -58,6 +58,16 @@ static int has_weak(const cyl_colortable *t)
     return 0;
 }
 
+/* Recompute the coarse chroma map of the vector background skip from uv. */
+static void chroma_any_update(cyl_colortable *t)
+{
+    unsigned u, v;
+    memset(t->chroma_any, 0, sizeof t->chroma_any);
+    for (u = 0; u < 256; u++)
+        for (v = 0; v < 256; v++)
+            if (t->uv[u][v]) t->chroma_any[u >> 7][v >> 4] |= (uint8_t)(1u << ((u >> 4) & 7u));
+}
+
 cyl_status cyl_colortable_clear_class(cyl_colortable *t, unsigned cls)
 {
     unsigned i, j;
@@ -75,6 +85,7 @@ cyl_status cyl_colortable_clear_class(cyl_colortable *t, unsigned cls)
     }
     t->lookup |= CYL_LOOKUP_UV_Y;   /* the class is now held off by uv and y alone */
     t->live &= keep;
+    chroma_any_update(t);
     return CYL_OK;
 }
 
@@ -112,6 +123,7 @@ void cyl_colortable_refresh(cyl_colortable *t)
         if (!redundant) need_uvy = 1;
     }
     t->live = live;
+    chroma_any_update(t);
     t->lookup = (uint8_t)((need_uvy || !need_yuv ? CYL_LOOKUP_UV_Y : 0u) | (need_yuv ? CYL_LOOKUP_YUV : 0u));
 }
 
@@ -140,6 +152,9 @@ cyl_status cyl_colortable_add_box(cyl_colortable *t, unsigned cls,
     for (u = u_lo; u <= u_hi; u++)
         for (v = v_lo; v <= v_hi; v++) t->uv[u][v] |= bit;
     for (y = y_lo; y <= y_hi; y++) t->y[y] |= bit;
+    for (u = u_lo >> 4; u <= (unsigned)u_hi >> 4; u++)
+        for (v = v_lo >> 4; v <= (unsigned)v_hi >> 4; v++)
+            t->chroma_any[u >> 3][v] |= (uint8_t)(1u << (u & 7u));
     t->lookup |= CYL_LOOKUP_UV_Y;   /* a box class is limited by uv and y */
     t->live |= bit;
     return CYL_OK;

@@ -6,7 +6,10 @@
  * - Classification and run-length encoding are fused: no class image is
  *   written. For the 4:2:2 and 4:2:0 formats with x_step 1, the chroma pair
  *   of two neighbouring pixels is looked up once; when it maps to no class
- *   and no run is open, both pixels are skipped without touching Y.
+ *   and no run is open, both pixels are skipped without touching Y. Where a
+ *   vector path exists (chroma_skip.h: SSSE3, NEON), background is skipped
+ *   16 pairs at a time on a coarse chroma map; pairs it cannot rule out go
+ *   to the scalar code, so results are bit-identical to the scalar path.
  * - Runs are stored only for classified pixels (background is implicit).
  * - Union-find links the larger root to the smaller index, so every run's
  *   parent index is <= its own and a component's root is its first run in
@@ -15,6 +18,7 @@
 #include "cyl/segment.h"
 #include "internal.h"
 #include "lowbit.h"
+#include "chroma_skip.h"
 
 /* cells from one brightness level of the 3-D table to the next */
 #define YUV_YSTRIDE (CYL_YUV_NC * CYL_YUV_NC)
@@ -28,6 +32,11 @@ typedef struct blob_acc {
     uint32_t alive;      /* 0 once merged into another blob or dropped */
     uint32_t strong;     /* 1 if some run is of the blob's own class (not a weak one) */
 } blob_acc;
+
+const char *cyl_segment_vector_path(void)
+{
+    return cyl_skip_select().name;
+}
 
 cyl_segment_params cyl_segment_params_default(void)
 {
@@ -106,6 +115,7 @@ typedef struct rle_ctx {
     uint32_t n, max;
     uint32_t min_run;
     int full;
+    cyl_skip_set skip;    /* vector background skip per format (NULL: scalar only) */
 } rle_ctx;
 
 static int emit(rle_ctx *c, uint32_t x, uint32_t y, uint32_t len, unsigned cls)
@@ -153,6 +163,7 @@ static int emit(rle_ctx *c, uint32_t x, uint32_t y, uint32_t len, unsigned cls)
 CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t y,
                                 const uint8_t *yp, const unsigned ysz, const uint8_t *up,
                                 const uint8_t *vp, const unsigned cs, uint32_t x0, uint32_t x1,
+                                cyl_skip_fn skip, const uint8_t *su, const uint8_t *sv,
                                 const unsigned lookup)
 {
     const cyl_mask (*uv)[256] = t->uv;
@@ -179,14 +190,25 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
         cyl_mask m;
         const cyl_mask *col;
         if (cur == CYL_CLASS_NONE) {
-            /* Background fast path: skip pairs whose chroma is in no class,
-             * two pairs at a time, without reading luma. */
+            /* Background fast path: skip pairs whose chroma is in no class without
+             * reading luma; 16 pairs at a time on the coarse chroma map where a vector
+             * path exists (chroma_skip.h), then two pairs at a time on uv itself. */
             const uint8_t *pu = up + (x / 2u) * cs, *pv = vp + (x / 2u) * cs;
-            while (x + 3u < x1 && (uv[pu[0]][pv[0]] | uv[pu[cs]][pv[cs]]) == 0) {
-                x += 4u; pu += 2u * cs; pv += 2u * cs;
+            if (uv[pu[0]][pv[0]] == 0) {
+                uint32_t xlim = x1;
+                x += 2u;
+                if (skip) {
+                    x = 2u * skip(su, sv, t->chroma_any, x / 2u, x1 / 2u);
+                    /* a block bit may be set by another chroma of the block: the scalar
+                     * test runs for a few pairs only before the vector one takes over */
+                    if (x + 16u < x1) xlim = x + 16u;
+                }
+                pu = up + (x / 2u) * cs; pv = vp + (x / 2u) * cs;
+                while (x + 3u < xlim && (uv[pu[0]][pv[0]] | uv[pu[cs]][pv[cs]]) == 0) {
+                    x += 4u; pu += 2u * cs; pv += 2u * cs;
+                }
+                continue;
             }
-            if (x + 1u < x1 && uv[pu[0]][pv[0]] == 0) { x += 2u; continue; }
-            if (x + 1u >= x1) break;
             m = uv[pu[0]][pv[0]];
             col = PAIR_COL(pu[0], pv[0]);
         } else {
@@ -219,21 +241,21 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
     }
 static int encode_yuyv(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r, uint32_t x0, uint32_t x1)
 {
-    ENCODE_BY_LOOKUP(c, t, y, r, 2u, r + 1, r + 3, 4u, x0, x1)
+    ENCODE_BY_LOOKUP(c, t, y, r, 2u, r + 1, r + 3, 4u, x0, x1, c->skip.yuyv, r, NULL)
 }
 static int encode_uyvy(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r, uint32_t x0, uint32_t x1)
 {
-    ENCODE_BY_LOOKUP(c, t, y, r + 1, 2u, r, r + 2, 4u, x0, x1)
+    ENCODE_BY_LOOKUP(c, t, y, r + 1, 2u, r, r + 2, 4u, x0, x1, c->skip.uyvy, r, NULL)
 }
 static int encode_nv12(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r,
                        const uint8_t *uv, uint32_t x0, uint32_t x1)
 {
-    ENCODE_BY_LOOKUP(c, t, y, r, 1u, uv, uv + 1, 2u, x0, x1)
+    ENCODE_BY_LOOKUP(c, t, y, r, 1u, uv, uv + 1, 2u, x0, x1, c->skip.nv12, uv, NULL)
 }
 static int encode_i420(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r,
                        const uint8_t *u, const uint8_t *v, uint32_t x0, uint32_t x1)
 {
-    ENCODE_BY_LOOKUP(c, t, y, r, 1u, u, v, 1u, x0, x1)
+    ENCODE_BY_LOOKUP(c, t, y, r, 1u, u, v, 1u, x0, x1, c->skip.i420, u, v)
 }
 #undef ENCODE_BY_LOOKUP
 
@@ -531,6 +553,11 @@ cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
     ctx.max = seg->max_runs;
     ctx.min_run = p->min_run_px;
     ctx.full = 0;
+    if (p->scalar_only) {
+        memset(&ctx.skip, 0, sizeof ctx.skip);
+    } else {
+        ctx.skip = cyl_skip_select();
+    }
     for (y = r.y; y < r.y + r.height; y += ys) {
         uint32_t b = ctx.n;
         int ok = encode_row(&ctx, t, img, y, r.x, xs, nx);

@@ -511,6 +511,171 @@ static void test_bruteforce_random(void **state)
     free(ref);
 }
 
+/* The coarse chroma map equals its definition (computed here from uv by brute force)
+ * after every kind of table edit. */
+static void check_chroma_map(const cyl_colortable *t)
+{
+    uint8_t m[2][16];
+    unsigned u, v;
+    memset(m, 0, sizeof m);
+    for (u = 0; u < 256; u++)
+        for (v = 0; v < 256; v++)
+            if (t->uv[u][v]) m[u / 128u][v / 16u] |= (uint8_t)(1u << ((u / 16u) % 8u));
+    assert_memory_equal(m, t->chroma_any, sizeof m);
+}
+
+static void test_chroma_map_kept(void **state)
+{
+    test_rng rng;
+    cyl_colortable t;
+    uint8_t *buf = (uint8_t *)malloc(CYL_TABLE_FILE_MAX_SIZE);
+    size_t len;
+    int i;
+    (void)state;
+    test_rng_seed(&rng, 20261202);
+    cyl_colortable_init(&t);
+    check_chroma_map(&t);
+    for (i = 0; i < 200; i++) {
+        unsigned cls = (unsigned)test_rng_int(&rng, 0, 7);
+        int op = (int)test_rng_int(&rng, 0, 9);
+        if (op < 7) {
+            uint8_t u0 = (uint8_t)test_rng_int(&rng, 0, 255), v0 = (uint8_t)test_rng_int(&rng, 0, 255);
+            uint8_t u1 = (uint8_t)test_rng_int(&rng, u0, u0 + 40 > 255 ? 255 : u0 + 40);
+            uint8_t v1 = (uint8_t)test_rng_int(&rng, v0, v0 + 40 > 255 ? 255 : v0 + 40);
+            assert_int_equal(cyl_colortable_add_box(&t, cls, 0, 255, u0, u1, v0, v1), CYL_OK);
+        } else if (op < 9) {
+            assert_int_equal(cyl_colortable_clear_class(&t, cls), CYL_OK);
+        } else {
+            /* a hand edit, then refresh */
+            t.uv[test_rng_int(&rng, 0, 255)][test_rng_int(&rng, 0, 255)] ^= (cyl_mask)(1u << cls);
+            cyl_colortable_refresh(&t);
+        }
+        check_chroma_map(&t);
+    }
+    /* and a loaded table carries it too */
+    assert_int_equal(cyl_colortable_save(&t, buf, CYL_TABLE_FILE_MAX_SIZE, &len), CYL_OK);
+    {
+        cyl_colortable t2;
+        cyl_colortable_init(&t2);
+        assert_int_equal(cyl_colortable_load(&t2, buf, len), CYL_OK);
+        check_chroma_map(&t2);
+        assert_memory_equal(t2.chroma_any, t.chroma_any, sizeof t.chroma_any);
+    }
+    free(buf);
+}
+
+/* The vector background skip against the scalar reference path: bit-identical runs and
+ * blobs on random wide frames (every 4:2:x format, ROIs, odd starts), with random tables
+ * whose classes cover small chroma boxes, so that the coarse map's 16x16 blocks are often
+ * set by chroma next to the background's (the scalar fallback is exercised), and frames
+ * mixing background chroma from everywhere with class colours and specks. */
+static void test_vector_path_identical(void **state)
+{
+    static const cyl_pixfmt fmts[] = { CYL_FMT_YUYV, CYL_FMT_UYVY, CYL_FMT_NV12, CYL_FMT_I420 };
+    test_rng rng;
+    uint32_t max_runs = 400000, max_blobs = 40000;
+    size_t ms = cyl_segment_mem_size(max_runs, max_blobs);
+    void *mem_a = malloc(ms), *mem_b = malloc(ms);
+    cyl_segmentation sa, sb;
+    int iter;
+    unsigned long total_runs = 0;
+    (void)state;
+    assert_int_equal(cyl_segmentation_init(&sa, mem_a, ms, max_runs, max_blobs), CYL_OK);
+    assert_int_equal(cyl_segmentation_init(&sb, mem_b, ms, max_runs, max_blobs), CYL_OK);
+    test_rng_seed(&rng, 12345);
+    for (iter = 0; iter < 600; iter++) {
+        cyl_colortable t;
+        canvas c;
+        cyl_image img;
+        cyl_segment_params p = cyl_segment_params_default();
+        uint32_t w = (uint32_t)test_rng_int(&rng, 1, 700), h = (uint32_t)test_rng_int(&rng, 1, 12);
+        cyl_pixfmt fmt = fmts[test_rng_int(&rng, 0, 3)];
+        uint8_t col[3][3];
+        unsigned k, n_cls = (unsigned)test_rng_int(&rng, 1, 3);
+        uint32_t i, j;
+        double p_col = test_rng_uniform(&rng) * 0.2;
+        size_t cap;
+        uint8_t *buf;
+        cyl_colortable_init(&t);
+        for (k = 0; k < n_cls; k++) {
+            uint8_t u0 = (uint8_t)test_rng_int(&rng, 0, 230), v0 = (uint8_t)test_rng_int(&rng, 0, 230);
+            uint8_t du = (uint8_t)test_rng_int(&rng, 0, 25), dv = (uint8_t)test_rng_int(&rng, 0, 25);
+            cyl_colortable_add_box(&t, k, 30, 240, u0, (uint8_t)(u0 + du), v0, (uint8_t)(v0 + dv));
+            col[k][0] = (uint8_t)test_rng_int(&rng, 30, 240);
+            col[k][1] = (uint8_t)(u0 + du / 2);
+            col[k][2] = (uint8_t)(v0 + dv / 2);
+        }
+        if (test_rng_int(&rng, 0, 2) == 0) {   /* a brightness-dependent part too */
+            unsigned yc, uc, vc;
+            for (yc = 0; yc < CYL_YUV_NY; yc += 2)
+                for (uc = 0; uc < CYL_YUV_NC; uc++)
+                    for (vc = 0; vc < CYL_YUV_NC; vc++) t.yuv[yc][uc][vc] &= (cyl_mask)~1u;
+            cyl_colortable_refresh(&t);
+        }
+        assert_true(canvas_alloc(&c, w, h));
+        for (j = 0; j < h; j++)
+            for (i = 0; i < w; i++) {
+                size_t o = (size_t)j * w + i;
+                if (test_rng_uniform(&rng) < p_col) {
+                    k = (unsigned)test_rng_int(&rng, 0, (int64_t)n_cls - 1);
+                    c.y[o] = col[k][0]; c.u[o] = col[k][1]; c.v[o] = col[k][2];
+                } else {
+                    /* background: grey-ish, or any chroma near a class's block */
+                    c.y[o] = (uint8_t)test_rng_int(&rng, 0, 255);
+                    if (test_rng_int(&rng, 0, 1)) {
+                        c.u[o] = (uint8_t)test_rng_int(&rng, 100, 156);
+                        c.v[o] = (uint8_t)test_rng_int(&rng, 100, 156);
+                    } else {
+                        k = (unsigned)test_rng_int(&rng, 0, (int64_t)n_cls - 1);
+                        c.u[o] = (uint8_t)((col[k][1] & 0xF0u) | (unsigned)test_rng_int(&rng, 0, 15));
+                        c.v[o] = (uint8_t)((col[k][2] & 0xF0u) | (unsigned)test_rng_int(&rng, 0, 15));
+                    }
+                }
+            }
+        for (j = 0; j < 3 && w > 40; j++)   /* a few long coloured stretches */
+            canvas_rect(&c, (int32_t)test_rng_int(&rng, 0, (int64_t)w - 1), 0, (int32_t)test_rng_int(&rng, 1, 80),
+                        (int32_t)h, col[0][0], col[0][1], col[0][2]);
+        cap = canvas_format_size(&c, fmt, 0);
+        buf = (uint8_t *)malloc(cap);
+        assert_true(canvas_to_format(&c, fmt, 0, 0x5A, buf, cap, &img));
+        p.min_run_px = (uint16_t)test_rng_int(&rng, 1, 3);
+        if (test_rng_int(&rng, 0, 2) == 0) {
+            p.roi.x = (uint32_t)test_rng_int(&rng, 0, (int64_t)w - 1);
+            p.roi.y = 0;
+            p.roi.width = (uint32_t)test_rng_int(&rng, 1, (int64_t)(w - p.roi.x));
+            p.roi.height = h;
+        }
+        p.scalar_only = 1;
+        assert_int_equal(cyl_segment(&t, &img, &p, &sa), CYL_OK);
+        p.scalar_only = 0;
+        assert_int_equal(cyl_segment(&t, &img, &p, &sb), CYL_OK);
+        assert_int_equal(sa.n_runs, sb.n_runs);
+        assert_int_equal(sa.n_blobs, sb.n_blobs);
+        assert_memory_equal(sa.runs, sb.runs, sizeof(cyl_run) * sa.n_runs);
+        assert_memory_equal(sa.blobs, sb.blobs, sizeof(cyl_blob) * sa.n_blobs);
+        total_runs += sa.n_runs;
+        free(buf);
+        canvas_free(&c);
+    }
+    assert_true(total_runs > 20000);   /* the frames were not trivially empty */
+    free(mem_a);
+    free(mem_b);
+}
+
+static void test_vector_path_name(void **state)
+{
+    const char *n = cyl_segment_vector_path();
+    (void)state;
+    assert_true(strcmp(n, "avx2") == 0 || strcmp(n, "ssse3") == 0 || strcmp(n, "neon") == 0 ||
+                strcmp(n, "scalar") == 0);
+#if defined(__aarch64__) && !defined(CYL_NO_SIMD)
+    assert_string_equal(n, "neon");
+#endif
+#if defined(__arm__) && !defined(__ARM_NEON)
+    assert_string_equal(n, "scalar");
+#endif
+}
+
 static void test_deterministic(void **state)
 {
     static const uint8_t speck[2][3] = { { ORANGE }, { GREEN } };
@@ -579,6 +744,9 @@ int main(void)
         cmocka_unit_test(test_records_its_parameters),
         cmocka_unit_test(test_bruteforce_random),
         cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_chroma_map_kept),
+        cmocka_unit_test(test_vector_path_identical),
+        cmocka_unit_test(test_vector_path_name),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -64,6 +64,13 @@ typedef struct cyl_colortable {
     cyl_mask live;                                    /* classes that can match some pixel; read only when
                                                          lookup is CYL_LOOKUP_YUV alone (set by
                                                          cyl_colortable_refresh()) */
+    uint8_t chroma_any[2][16];                        /* coarse chroma map for the vector background skip:
+                                                         bit (U >> 4) & 7 of chroma_any[U >> 7][V >> 4] is
+                                                         set when some uv[U'][V'] with U' >> 4 == U >> 4 and
+                                                         V' >> 4 == V >> 4 is non-zero (16x16 blocks of 16
+                                                         levels); a superset is correct, a missing bit is
+                                                         not; kept by every function here and by
+                                                         cyl_colortable_refresh() */
     char name[CYL_MAX_CLASSES][CYL_CLASS_NAME_LEN];   /* NUL-terminated class names ("" = unused) */
     uint8_t rgb[CYL_MAX_CLASSES][3];                  /* display colour of each class (overlays), 0..255 */
 } cyl_colortable;
@@ -110,7 +117,8 @@ static inline cyl_mask cyl_colortable_mask(const cyl_colortable *t, uint8_t Y, u
 /* 1 if any class has a brightness-dependent (3-D) part, i.e. some yuv cell is not all ones. */
 int cyl_colortable_has_yuv(const cyl_colortable *t);
 
-/* Recompute t->lookup from the table's contents (after editing uv, y or yuv by hand).
+/* Recompute t->lookup, t->live and t->chroma_any from the table's contents (after editing
+ * uv, y or yuv by hand).
  * A lookup field with extra bits set is still correct, only slower; one with a bit
  * missing makes segmentation disagree with cyl_colortable_mask(). */
 void cyl_colortable_refresh(cyl_colortable *t);

@@ -92,10 +92,20 @@ typedef struct cyl_segment_params {
     uint16_t y_step;          /* sample every y_step-th row (default 1) */
     cyl_roi roi;              /* region of interest (default all zero = whole frame) */
     cyl_class_params cls[CYL_MAX_CLASSES]; /* per-class rules */
+    uint8_t scalar_only;      /* 1: use the scalar C99 reference path even where a vector path
+                                 exists (comparisons, tests); results are bit-identical either
+                                 way (default 0) */
 } cyl_segment_params;
 
 /* Defaults described above. */
 cyl_segment_params cyl_segment_params_default(void);
+
+/* The vector path cyl_segment() uses on this build and CPU: "avx2" or "ssse3" (x86, chosen
+ * at run time unless the build targets them), "neon" (AArch64, or ARMv7 built with NEON) or
+ * "scalar" (every other target, Cortex-M included, and builds with -DCYL_NO_SIMD). The
+ * vector path skips background 32 pixels at a time (see the design notes in segment.c);
+ * where a run may start, the scalar code decides. */
+const char *cyl_segment_vector_path(void);
 
 /* Result of cyl_segment(). Set up with cyl_segmentation_init(); reused frame after frame. */
 typedef struct cyl_segmentation {
