@@ -24,6 +24,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fstream>
@@ -282,10 +283,11 @@ int main(int argc, char **argv)
     }
     for (const auto &f : frames) set_frac[0] += coloured_fraction(table, f) / (double)frames.size();
 
-    // Large frames: frames/s of cyl_segment on one core.
-    struct Large { uint32_t w, h; cyl_pixfmt fmt; const char *name; double fps; };
-    Large large[] = {{2048, 1536, CYL_FMT_YUYV, "2048x1536 YUYV", 0}, {2048, 1536, CYL_FMT_NV12, "2048x1536 NV12", 0},
-                     {3840, 2160, CYL_FMT_YUYV, "3840x2160 YUYV", 0}, {3840, 2160, CYL_FMT_NV12, "3840x2160 NV12", 0}};
+    // Large frames: frames/s of cyl_segment on one core, and of two bands on two threads
+    // (cyl_segment_band on each, then cyl_segment_join), checked identical to cyl_segment.
+    struct Large { uint32_t w, h; cyl_pixfmt fmt; const char *name; double fps, fps2; };
+    Large large[] = {{2048, 1536, CYL_FMT_YUYV, "2048x1536 YUYV", 0, 0}, {2048, 1536, CYL_FMT_NV12, "2048x1536 NV12", 0, 0},
+                     {3840, 2160, CYL_FMT_YUYV, "3840x2160 YUYV", 0, 0}, {3840, 2160, CYL_FMT_NV12, "3840x2160 NV12", 0, 0}};
     for (Large &L : large) {
         const uint32_t max_runs = cyl_segment_max_runs(L.w, L.h, &params) / 8, max_blobs = 16384;
         std::vector<uint8_t> mem(cyl_segment_mem_size(max_runs, max_blobs));
@@ -311,18 +313,48 @@ int main(int argc, char **argv)
             compared++;
         }
         L.fps = 1e6 / median(t);
-        std::printf("%-52s %12.1f   %.0f frames/s on one core\n", (std::string("libcyl on ") + L.name).c_str(),
-                    median(t), L.fps);
+        // two bands on two threads
+        std::vector<cyl_run> band[2];
+        band[0].resize(max_runs);
+        band[1].resize(max_runs);
+        std::vector<double> t2;
+        for (int i = 0; i < std::max(9, iterations / 50); i++) {
+            cyl_image img;
+            cyl_image_wrap(&img, L.fmt, L.w, L.h, fr[i % 3].data(), 0);
+            const uint32_t rows = cyl_segment_rows(&img, &params), mid = rows / 2;
+            uint32_t n[2] = {0, 0};
+            double t0 = now_us();
+            std::thread worker([&] { cyl_segment_band(&table, &img, &params, mid, rows, band[1].data(), max_runs, &n[1]); });
+            cyl_segment_band(&table, &img, &params, 0, mid, band[0].data(), max_runs, &n[0]);
+            worker.join();
+            const cyl_run *br[2] = {band[0].data(), band[1].data()};
+            cyl_segment_join(&table, &img, &params, br, n, 2, &big);
+            t2.push_back(now_us() - t0);
+            if (i < 3) {  // the joined result is cyl_segment's
+                std::vector<cyl_run> rj(big.runs, big.runs + big.n_runs);
+                std::vector<cyl_blob> bj(big.blobs, big.blobs + big.n_blobs);
+                cyl_segment(&table, &img, &params, &big);
+                identical &= big.n_runs == rj.size() && big.n_blobs == bj.size() &&
+                             std::memcmp(rj.data(), big.runs, sizeof(cyl_run) * rj.size()) == 0 &&
+                             std::memcmp(bj.data(), big.blobs, sizeof(cyl_blob) * bj.size()) == 0;
+                compared++;
+            }
+        }
+        L.fps2 = 1e6 / median(t2);
+        std::printf("%-52s %12.1f   %.0f frames/s on one core; two bands on two threads %.0f frames/s (%.2fx)\n",
+                    (std::string("libcyl on ") + L.name).c_str(), median(t), L.fps, L.fps2, L.fps2 / L.fps);
     }
     std::printf("{\"libcyl_us\": %.2f, \"memcpy_us\": %.2f, \"opencv_us\": %.2f, \"libcyl_over_memcpy\": %.3f, "
                 "\"opencv_over_libcyl\": %.2f, \"libcyl_3d_us\": %.2f, \"table3d_over_box\": %.3f, "
                 "\"typical_coloured_frac\": %.3f, \"dense_libcyl_over_memcpy\": %.3f, \"dense_coloured_frac\": %.3f, "
                 "\"speckle_libcyl_over_memcpy\": %.3f, \"worst_libcyl_over_memcpy\": %.3f, "
                 "\"fps_2048x1536_yuyv\": %.1f, \"fps_2048x1536_nv12\": %.1f, \"fps_3840x2160_yuyv\": %.1f, "
-                "\"fps_3840x2160_nv12\": %.1f, \"vector_path\": \"%s\", \"scalar_libcyl_over_memcpy\": %.3f, "
+                "\"fps_3840x2160_nv12\": %.1f, \"fps_2048x1536_yuyv_2cores\": %.1f, \"fps_2048x1536_nv12_2cores\": %.1f, "
+                "\"fps_3840x2160_yuyv_2cores\": %.1f, \"fps_3840x2160_nv12_2cores\": %.1f, \"vector_path\": \"%s\", \"scalar_libcyl_over_memcpy\": %.3f, "
                 "\"scalar_worst_libcyl_over_memcpy\": %.3f, \"simd_bit_identical\": %s, \"simd_frames_compared\": %d}\n",
                 m_cyl, m_mem, m_cv, m_cyl / m_mem, m_cv / m_cyl, m_3d, m_3d / m_cyl, set_frac[0], set_ratio[1], set_frac[1],
-                set_ratio[2], worst, large[0].fps, large[1].fps, large[2].fps, large[3].fps, cyl_segment_vector_path(),
+                set_ratio[2], worst, large[0].fps, large[1].fps, large[2].fps, large[3].fps, large[0].fps2, large[1].fps2, large[2].fps2,
+                large[3].fps2, cyl_segment_vector_path(),
                 scalar_ratio[0], std::max(scalar_ratio[1], scalar_ratio[2]), identical ? "true" : "false", compared);
     return 0;
 }

@@ -498,39 +498,183 @@ static cyl_status check_params(const cyl_segment_params *p)
     return CYL_OK;
 }
 
+/* Checks shared by cyl_segment(), cyl_segment_band() and cyl_segment_join(): *pp is set to the
+ * defaults when NULL; *r receives the resolved ROI and *nx the samples per row. */
+static cyl_status prepare(const cyl_colortable *t, const cyl_image *img, const cyl_segment_params **pp,
+                          cyl_segment_params *defaults, cyl_roi *r, uint32_t *nx)
+{
+    cyl_status s;
+    if (!t) return CYL_ERR_ARG;
+    if (!*pp) { *defaults = cyl_segment_params_default(); *pp = defaults; }
+    s = check_params(*pp);
+    if (s != CYL_OK) return s;
+    s = cyl_image_check(img);
+    if (s != CYL_OK) return s;
+    if (!cyl_roi_resolve(img, &(*pp)->roi, r)) return CYL_ERR_SIZE;
+    *nx = (r->width + (*pp)->x_step - 1u) / (*pp)->x_step;
+    return CYL_OK;
+}
+
+static void rle_begin(rle_ctx *ctx, cyl_run *runs, uint32_t max_runs, const cyl_segment_params *p)
+{
+    ctx->runs = runs;
+    ctx->n = 0;
+    ctx->max = max_runs;
+    ctx->min_run = p->min_run_px;
+    ctx->full = 0;
+    if (p->scalar_only) {
+        memset(&ctx->skip, 0, sizeof ctx->skip);
+    } else {
+        ctx->skip = cyl_skip_select();
+    }
+}
+
+/* The class each class's runs connect as (a weak class: its strong class); 1 if any is weak. */
+static int class_equivalence(const cyl_colortable *t, uint8_t eq[CYL_MAX_CLASSES])
+{
+    unsigned k;
+    int weak = 0;
+    for (k = 0; k < CYL_MAX_CLASSES; k++) {
+        unsigned w = t->weak_of[k];
+        eq[k] = (uint8_t)(w < CYL_MAX_CLASSES && t->weak_of[w] == CYL_CLASS_NONE ? w : k);
+        weak |= eq[k] != k;
+    }
+    return weak;
+}
+
+static cyl_status finish(cyl_segmentation *seg, const cyl_image *img, const cyl_segment_params *p,
+                         const cyl_roi *r, uint32_t nx, const uint8_t *eq, int weak);
+
 cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
                        const cyl_segment_params *p, cyl_segmentation *seg)
 {
     cyl_segment_params defaults;
     cyl_roi r;
     rle_ctx ctx;
-    blob_acc *acc;
-    cyl_run *runs;
-    uint32_t xs, ys, nx, y, prev_b = 0, prev_e = 0, i, nb = 0, k;
+    uint32_t nx, y, prev_b = 0, prev_e = 0;
     uint8_t eq[CYL_MAX_CLASSES];
-    int weak = 0;
+    int weak;
     cyl_status s;
 
-    if (!t || !seg || !seg->runs || !seg->blobs || !seg->work) return CYL_ERR_ARG;
-    if (!p) { defaults = cyl_segment_params_default(); p = &defaults; }
-    s = check_params(p);
+    if (!seg || !seg->runs || !seg->blobs || !seg->work) return CYL_ERR_ARG;
+    s = prepare(t, img, &p, &defaults, &r, &nx);
     if (s != CYL_OK) return s;
-    s = cyl_image_check(img);
-    if (s != CYL_OK) return s;
-    if (!cyl_roi_resolve(img, &p->roi, &r)) return CYL_ERR_SIZE;
+    weak = class_equivalence(t, eq);
 
-    xs = p->x_step;
-    ys = p->y_step;
-    nx = (r.width + xs - 1u) / xs;
-    seg->n_runs = 0;
-    seg->n_blobs = 0;
+    /* 1. classify + run-length encode, connecting each row to the previous one */
+    rle_begin(&ctx, seg->runs, seg->max_runs, p);
+    for (y = r.y; y < r.y + r.height; y += p->y_step) {
+        uint32_t b = ctx.n;
+        int ok = encode_row(&ctx, t, img, y, r.x, p->x_step, nx);
+        if (weak) connect_within_row(seg->runs, b, ctx.n, p->x_step, eq);
+        connect_rows(seg->runs, prev_b, prev_e, b, ctx.n, p->x_step, eq);
+        prev_b = b;
+        prev_e = ctx.n;
+        if (!ok) break;
+    }
+    seg->n_runs = ctx.n;
+    seg->truncated = ctx.full ? CYL_SEG_RUNS_FULL : 0u;
+    return finish(seg, img, p, &r, nx, eq, weak);
+}
+
+uint32_t cyl_segment_rows(const cyl_image *img, const cyl_segment_params *p)
+{
+    cyl_segment_params defaults;
+    cyl_roi r;
+    if (!p) { defaults = cyl_segment_params_default(); p = &defaults; }
+    if (!img || p->y_step == 0 || !cyl_roi_resolve(img, &p->roi, &r)) return 0;
+    return (r.height + p->y_step - 1u) / p->y_step;
+}
+
+cyl_status cyl_segment_band(const cyl_colortable *t, const cyl_image *img, const cyl_segment_params *p,
+                            uint32_t row_begin, uint32_t row_end, cyl_run *runs, uint32_t max_runs,
+                            uint32_t *n_runs)
+{
+    cyl_segment_params defaults;
+    cyl_roi r;
+    rle_ctx ctx;
+    uint32_t nx, j, rows;
+    cyl_status s;
+
+    if (!runs || !n_runs) return CYL_ERR_ARG;
+    *n_runs = 0;
+    s = prepare(t, img, &p, &defaults, &r, &nx);
+    if (s != CYL_OK) return s;
+    rows = (r.height + p->y_step - 1u) / p->y_step;
+    if (row_begin > row_end || row_end > rows) return CYL_ERR_ARG;
+    rle_begin(&ctx, runs, max_runs, p);
+    for (j = row_begin; j < row_end; j++)
+        if (!encode_row(&ctx, t, img, r.y + j * p->y_step, r.x, p->x_step, nx)) break;
+    *n_runs = ctx.n;
+    return ctx.full ? CYL_TRUNCATED : CYL_OK;
+}
+
+cyl_status cyl_segment_join(const cyl_colortable *t, const cyl_image *img, const cyl_segment_params *p,
+                            const cyl_run *const *band_runs, const uint32_t *band_n_runs, unsigned n_bands,
+                            cyl_segmentation *seg)
+{
+    cyl_segment_params defaults;
+    cyl_roi r;
+    uint32_t nx, i, n = 0, prev_b = 0, prev_e = 0, row_b = 0;
+    uint8_t eq[CYL_MAX_CLASSES];
+    unsigned k;
+    int weak;
+    cyl_status s;
+
+    if (!seg || !seg->runs || !seg->blobs || !seg->work || (n_bands && (!band_runs || !band_n_runs)))
+        return CYL_ERR_ARG;
+    s = prepare(t, img, &p, &defaults, &r, &nx);
+    if (s != CYL_OK) return s;
+    weak = class_equivalence(t, eq);
     seg->truncated = 0;
+    /* gather the bands' runs in order, as cyl_segment() would have written them */
+    for (k = 0; k < n_bands; k++) {
+        if (band_n_runs[k] && !band_runs[k]) return CYL_ERR_ARG;
+        for (i = 0; i < band_n_runs[k]; i++) {
+            cyl_run *d;
+            if (n >= seg->max_runs) { seg->truncated = CYL_SEG_RUNS_FULL; break; }
+            d = &seg->runs[n];
+            *d = band_runs[k][i];
+            if (n > 0 && (d->y < seg->runs[n - 1u].y ||
+                          (d->y == seg->runs[n - 1u].y && d->x <= seg->runs[n - 1u].x)))
+                return CYL_ERR_ARG;   /* the bands must be in row order */
+            d->blob = n;
+            d->next = CYL_NONE;
+            n++;
+        }
+    }
+    /* connect row by row: runs of a row with those of the sampled row above */
+    for (i = 0; i <= n; i++) {
+        if (i < n && i > row_b && seg->runs[i].y == seg->runs[row_b].y) continue;
+        if (i > row_b) {   /* row [row_b, i) */
+            if (weak) connect_within_row(seg->runs, row_b, i, p->x_step, eq);
+            if (prev_e > prev_b && (uint32_t)seg->runs[prev_b].y + p->y_step == seg->runs[row_b].y)
+                connect_rows(seg->runs, prev_b, prev_e, row_b, i, p->x_step, eq);
+            prev_b = row_b;
+            prev_e = i;
+            row_b = i;
+        }
+    }
+    seg->n_runs = n;
+    return finish(seg, img, p, &r, nx, eq, weak);
+}
+
+/* Steps 2-5, on the connected runs seg->runs[0, seg->n_runs) of the ROI r. */
+static cyl_status finish(cyl_segmentation *seg, const cyl_image *img, const cyl_segment_params *p,
+                         const cyl_roi *r, uint32_t nx, const uint8_t *eq, int weak)
+{
+    blob_acc *acc;
+    cyl_run *runs = seg->runs;
+    const uint32_t xs = p->x_step, ys = p->y_step, n_runs = seg->n_runs;
+    uint32_t i, nb = 0, k;
+
+    seg->n_blobs = 0;
     seg->x_step = (uint16_t)xs;
     seg->y_step = (uint16_t)ys;
-    seg->x_origin = r.x;
-    seg->y_origin = r.y;
-    seg->x_last = r.x + (nx - 1u) * xs;
-    seg->y_last = r.y + ((r.height - 1u) / ys) * ys;
+    seg->x_origin = r->x;
+    seg->y_origin = r->y;
+    seg->x_last = r->x + (nx - 1u) * xs;
+    seg->y_last = r->y + ((r->height - 1u) / ys) * ys;
     seg->frame_width = img->width;
     seg->frame_height = img->height;
     seg->min_run_px = p->min_run_px;
@@ -540,40 +684,10 @@ cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
         seg->merge_gap_px[k] = p->cls[k].merge_gap_px;
     }
 
-    for (k = 0; k < CYL_MAX_CLASSES; k++) {
-        unsigned w = t->weak_of[k];
-        eq[k] = (uint8_t)(w < CYL_MAX_CLASSES && t->weak_of[w] == CYL_CLASS_NONE ? w : k);
-        weak |= eq[k] != k;
-    }
-
-    /* 1. classify + run-length encode, connecting each row to the previous one */
-    runs = seg->runs;
-    ctx.runs = runs;
-    ctx.n = 0;
-    ctx.max = seg->max_runs;
-    ctx.min_run = p->min_run_px;
-    ctx.full = 0;
-    if (p->scalar_only) {
-        memset(&ctx.skip, 0, sizeof ctx.skip);
-    } else {
-        ctx.skip = cyl_skip_select();
-    }
-    for (y = r.y; y < r.y + r.height; y += ys) {
-        uint32_t b = ctx.n;
-        int ok = encode_row(&ctx, t, img, y, r.x, xs, nx);
-        if (weak) connect_within_row(runs, b, ctx.n, xs, eq);
-        connect_rows(runs, prev_b, prev_e, b, ctx.n, xs, eq);
-        prev_b = b;
-        prev_e = ctx.n;
-        if (!ok) break;
-    }
-    seg->n_runs = ctx.n;
-    if (ctx.full) seg->truncated |= CYL_SEG_RUNS_FULL;
-
     /* 2. labels: flatten, then number the roots in raster order. A root's
      *    label is parked in its `next` field until every run is labelled. */
-    for (i = 0; i < ctx.n; i++) runs[i].blob = runs[runs[i].blob].blob;
-    for (i = 0; i < ctx.n; i++) {
+    for (i = 0; i < n_runs; i++) runs[i].blob = runs[runs[i].blob].blob;
+    for (i = 0; i < n_runs; i++) {
         uint32_t root = runs[i].blob;
         if (root == i) {
             if (nb < seg->max_blobs) runs[i].next = nb++;
@@ -588,7 +702,7 @@ cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
         memset(&acc[k], 0, sizeof acc[k]);
         acc[k].alive = 1;
     }
-    for (i = 0; i < ctx.n; i++) {
+    for (i = 0; i < n_runs; i++) {
         cyl_run *rn = &runs[i];
         uint32_t bi = rn->blob, xe;
         cyl_blob *b;
@@ -628,7 +742,7 @@ cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
     sort_blobs(seg->blobs, k);
 
     /* 5. final labels: runs of dropped blobs get CYL_NONE */
-    for (i = 0; i < ctx.n; i++) runs[i].blob = CYL_NONE;
+    for (i = 0; i < n_runs; i++) runs[i].blob = CYL_NONE;
     for (k = 0; k < seg->n_blobs; k++) {
         uint32_t ri;
         for (ri = seg->blobs[k].first_run; ri != CYL_NONE; ri = runs[ri].next) runs[ri].blob = k;

@@ -662,6 +662,109 @@ static void test_vector_path_identical(void **state)
     free(mem_b);
 }
 
+/* Bands encoded separately and joined give what cyl_segment() gives, bit for bit: random frames,
+ * steps, ROIs, weak classes and band splits (empty bands included). */
+static void test_bands_join_identical(void **state)
+{
+    static const uint8_t speck[4][3] = { { ORANGE }, { GREEN }, { 200, 120, 170 }, { 150, 200, 170 } };
+    static const cyl_pixfmt fmts[] = { CYL_FMT_YUYV, CYL_FMT_NV12, CYL_FMT_I420, CYL_FMT_YUV444P };
+    test_rng rng;
+    uint32_t max_runs = 100000, max_blobs = 10000;
+    size_t ms = cyl_segment_mem_size(max_runs, max_blobs);
+    void *mem_a = malloc(ms), *mem_b = malloc(ms);
+    cyl_run *band_buf = (cyl_run *)malloc(sizeof(cyl_run) * max_runs);
+    cyl_segmentation sa, sb;
+    int iter, joined_across = 0;
+    (void)state;
+    make_table();
+    cyl_colortable_set_class(&table, 3, "green~", 0, 128, 0);
+    cyl_colortable_add_box(&table, 3, 100, 255, 190, 210, 160, 180);
+    assert_int_equal(cyl_colortable_set_weak(&table, 3, 1), CYL_OK);
+    assert_int_equal(cyl_segmentation_init(&sa, mem_a, ms, max_runs, max_blobs), CYL_OK);
+    assert_int_equal(cyl_segmentation_init(&sb, mem_b, ms, max_runs, max_blobs), CYL_OK);
+    test_rng_seed(&rng, 424242);
+    for (iter = 0; iter < 400; iter++) {
+        canvas c;
+        cyl_image img;
+        cyl_segment_params p = cyl_segment_params_default();
+        uint32_t w = (uint32_t)test_rng_int(&rng, 1, 300), h = (uint32_t)test_rng_int(&rng, 1, 80);
+        cyl_pixfmt fmt = fmts[test_rng_int(&rng, 0, 3)];
+        uint32_t rows, cut[6], n_runs[5], used = 0, i;
+        const cyl_run *band_runs[5];
+        unsigned nbands = (unsigned)test_rng_int(&rng, 1, 5), k;
+        size_t cap;
+        uint8_t *buf;
+        int nrect = (int)test_rng_int(&rng, 0, 15);
+        assert_true(canvas_alloc(&c, w, h));
+        canvas_fill(&c, GREY);
+        for (i = 0; i < (uint32_t)nrect; i++) {
+            const uint8_t *col = speck[test_rng_int(&rng, 0, 3)];
+            canvas_rect(&c, (int32_t)test_rng_int(&rng, -5, (int64_t)w), (int32_t)test_rng_int(&rng, -5, (int64_t)h),
+                        (int32_t)test_rng_int(&rng, 1, 60), (int32_t)test_rng_int(&rng, 1, 40), col[0], col[1], col[2]);
+        }
+        canvas_speckle(&c, &rng, test_rng_uniform(&rng) * 0.2, speck, 4);
+        cap = canvas_format_size(&c, fmt, 0);
+        buf = (uint8_t *)malloc(cap);
+        assert_true(canvas_to_format(&c, fmt, 0, 0, buf, cap, &img));
+        p.min_run_px = (uint16_t)test_rng_int(&rng, 1, 3);
+        p.x_step = (uint16_t)(test_rng_int(&rng, 0, 3) ? 1 : 2);
+        p.y_step = (uint16_t)(test_rng_int(&rng, 0, 3) ? 1 : test_rng_int(&rng, 2, 3));
+        if (test_rng_int(&rng, 0, 2) == 0) {
+            p.roi.x = (uint32_t)test_rng_int(&rng, 0, (int64_t)w - 1);
+            p.roi.y = (uint32_t)test_rng_int(&rng, 0, (int64_t)h - 1);
+            p.roi.width = (uint32_t)test_rng_int(&rng, 1, (int64_t)(w - p.roi.x));
+            p.roi.height = (uint32_t)test_rng_int(&rng, 1, (int64_t)(h - p.roi.y));
+        }
+        assert_int_equal(cyl_segment(&table, &img, &p, &sa), CYL_OK);
+        rows = cyl_segment_rows(&img, &p);
+        assert_true(rows >= 1);
+        /* band limits: sorted random cuts, so some bands may be empty */
+        cut[0] = 0;
+        cut[nbands] = rows;
+        for (k = 1; k < nbands; k++) cut[k] = (uint32_t)test_rng_int(&rng, 0, rows);
+        for (k = 1; k < nbands; k++) {
+            unsigned m;
+            for (m = k + 1; m < nbands; m++)
+                if (cut[m] < cut[k]) { uint32_t tmp = cut[k]; cut[k] = cut[m]; cut[m] = tmp; }
+        }
+        for (k = 0; k < nbands; k++) {
+            cyl_run *dst = band_buf + used;
+            assert_int_equal(cyl_segment_band(&table, &img, &p, cut[k], cut[k + 1], dst, max_runs - used, &n_runs[k]),
+                             CYL_OK);
+            band_runs[k] = dst;
+            used += n_runs[k];
+        }
+        assert_int_equal(cyl_segment_join(&table, &img, &p, band_runs, n_runs, nbands, &sb), CYL_OK);
+        assert_int_equal(sa.n_runs, sb.n_runs);
+        assert_int_equal(sa.n_blobs, sb.n_blobs);
+        assert_memory_equal(sa.runs, sb.runs, sizeof(cyl_run) * sa.n_runs);
+        assert_memory_equal(sa.blobs, sb.blobs, sizeof(cyl_blob) * sa.n_blobs);
+        assert_memory_equal(sa.class_first, sb.class_first, sizeof sa.class_first);
+        assert_memory_equal(sa.class_count, sb.class_count, sizeof sa.class_count);
+        assert_int_equal(sa.x_last, sb.x_last);
+        assert_int_equal(sa.y_last, sb.y_last);
+        for (i = 0; i < sa.n_blobs; i++)   /* some blob crosses a seam */
+            for (k = 1; k < nbands; k++)
+                if (cut[k] > 0 && cut[k] < rows && sa.blobs[i].y0 < p.roi.y + cut[k] * p.y_step &&
+                    sa.blobs[i].y1 >= p.roi.y + cut[k] * p.y_step) joined_across++;
+        /* bands given out of order are refused */
+        if (nbands >= 2 && n_runs[0] > 0 && n_runs[nbands - 1] > 0 && cut[1] < cut[nbands - 1]) {
+            const cyl_run *rev[2];
+            uint32_t nrev[2];
+            rev[0] = band_runs[nbands - 1]; nrev[0] = n_runs[nbands - 1];
+            rev[1] = band_runs[0]; nrev[1] = n_runs[0];
+            assert_int_equal(cyl_segment_join(&table, &img, &p, rev, nrev, 2, &sb), CYL_ERR_ARG);
+        }
+        assert_int_equal(cyl_segment_band(&table, &img, &p, 0, rows + 1, band_buf, max_runs, &n_runs[0]), CYL_ERR_ARG);
+        free(buf);
+        canvas_free(&c);
+    }
+    assert_true(joined_across > 200);
+    free(mem_a);
+    free(mem_b);
+    free(band_buf);
+}
+
 static void test_vector_path_name(void **state)
 {
     const char *n = cyl_segment_vector_path();
@@ -747,6 +850,7 @@ int main(void)
         cmocka_unit_test(test_chroma_map_kept),
         cmocka_unit_test(test_vector_path_identical),
         cmocka_unit_test(test_vector_path_name),
+        cmocka_unit_test(test_bands_join_identical),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -149,6 +149,33 @@ cyl_status cyl_segmentation_init(cyl_segmentation *seg, void *mem, size_t mem_si
 cyl_status cyl_segment(const cyl_colortable *t, const cyl_image *img,
                        const cyl_segment_params *p, cyl_segmentation *seg);
 
+/* ---- one frame on several cores ------------------------------------------
+ * The library runs no threads; a caller that has cores to spare splits the frame into
+ * horizontal bands of sampled rows, encodes each band on its own thread into its own run
+ * buffer with cyl_segment_band(), and then, on one thread, cyl_segment_join() connects the
+ * runs across the seams and builds the blobs. The result is bit-identical to cyl_segment()
+ * on the same frame (when no buffer overflows). Classification and run-length encoding are
+ * most of the work on busy frames; the join is linear in the runs. */
+
+/* Number of sampled rows of the ROI grid (0 if the ROI does not fit the image). */
+uint32_t cyl_segment_rows(const cyl_image *img, const cyl_segment_params *p);
+
+/* Encode sampled rows [row_begin, row_end) of the ROI grid (row j is image row roi.y + j * y_step)
+ * into runs[0, *n_runs), in (y, x) order. Reads t and img only: several calls on disjoint bands
+ * may run at once. CYL_TRUNCATED when max_runs was too small (the runs that fitted are kept),
+ * CYL_ERR_ARG for a bad band. */
+cyl_status cyl_segment_band(const cyl_colortable *t, const cyl_image *img, const cyl_segment_params *p,
+                            uint32_t row_begin, uint32_t row_end, cyl_run *runs, uint32_t max_runs,
+                            uint32_t *n_runs);
+
+/* Join n_bands bands, given top to bottom (band k: band_runs[k][0, band_n_runs[k])), into seg as
+ * cyl_segment() would have made it: runs copied into seg->runs, connected within and across
+ * bands, then blobs. Same t, img and p as the bands were encoded with. Returns as cyl_segment();
+ * CYL_ERR_ARG when the bands are out of row order. */
+cyl_status cyl_segment_join(const cyl_colortable *t, const cyl_image *img, const cyl_segment_params *p,
+                            const cyl_run *const *band_runs, const uint32_t *band_n_runs, unsigned n_bands,
+                            cyl_segmentation *seg);
+
 #ifdef __cplusplus
 }
 #endif
