@@ -173,7 +173,8 @@ int main(int argc, char **argv)
     cv::Mat bgr, mask, labels, stats, centroids;
     const cv::Scalar lo[2] = {cv::Scalar(0, 90, 200), cv::Scalar(60, 150, 0)};
     const cv::Scalar hi[2] = {cv::Scalar(120, 190, 255), cv::Scalar(170, 255, 120)};
-    std::vector<double> t_cyl, t_mem, t_cv, t_3d, t_scalar;
+    std::vector<double> t_cyl, t_mem, t_cv, t_3d, t_scalar, t_cls;
+    std::vector<uint8_t> class_map(kW * kH);
     unsigned long sink = 0, cv_blobs = 0, cyl_blobs = 0;
     for (int i = 0; i < iterations; i++) {
         const std::vector<uint8_t> &f = frames[i % nframes];
@@ -193,6 +194,8 @@ int main(int argc, char **argv)
         cyl_segment(&table, &img, &scalar_params, &seg);
         double t8 = now_us();
         t_scalar.push_back(t8 - t7);
+        cyl_classify(&table, &img, nullptr, 1, 1, class_map.data(), kW);   // the overlay's class map
+        t_cls.push_back(now_us() - t8);
         t_mem.push_back(t1 - t0);
         t_cyl.push_back(t3 - t2);
         t_3d.push_back(t7 - t6);
@@ -209,7 +212,7 @@ int main(int argc, char **argv)
         }
     }
     double m_cyl = median(t_cyl), m_mem = median(t_mem), m_cv = median(t_cv), m_3d = median(t_3d),
-           m_scalar = median(t_scalar);
+           m_scalar = median(t_scalar), m_cls = median(t_cls);
     // the vector path against the scalar reference, bit for bit, on every frame of every set
     const uint32_t cmp_runs = cyl_segment_max_runs(kW, kH, &params), cmp_blobs = 65535;
     std::vector<uint8_t> cmp_mem(cyl_segment_mem_size(cmp_runs, cmp_blobs));
@@ -236,6 +239,8 @@ int main(int argc, char **argv)
     std::printf("%-52s %12.1f %9.2fx\n", (std::string("libcyl classify+RLE+blobs, ") + cyl_segment_vector_path() + " path").c_str(),
                 m_cyl, m_cyl / m_mem);
     std::printf("%-52s %12.1f %9.2fx\n", "libcyl, scalar reference path", m_scalar, m_scalar / m_mem);
+    std::printf("%-52s %12.1f %9.2fx  (%.2fx the segmentation)\n", "cyl_classify: the class map an overlay draws", m_cls,
+                m_cls / m_mem, m_cls / m_cyl);
     std::printf("%-52s %12.1f %9.2fx\n", "libcyl, same classes as a learned 3-D table", m_3d, m_3d / m_mem);
     std::printf("%-52s %12.1f %9.2fx\n", "OpenCV cvtColor+2 inRange+2 connectedComponents", m_cv, m_cv / m_mem);
     std::printf("libcyl blobs/frame %.2f; libcyl is %.1fx faster than OpenCV (sink %lu)\n",
@@ -351,10 +356,12 @@ int main(int argc, char **argv)
                 "\"fps_2048x1536_yuyv\": %.1f, \"fps_2048x1536_nv12\": %.1f, \"fps_3840x2160_yuyv\": %.1f, "
                 "\"fps_3840x2160_nv12\": %.1f, \"fps_2048x1536_yuyv_2cores\": %.1f, \"fps_2048x1536_nv12_2cores\": %.1f, "
                 "\"fps_3840x2160_yuyv_2cores\": %.1f, \"fps_3840x2160_nv12_2cores\": %.1f, \"vector_path\": \"%s\", \"scalar_libcyl_over_memcpy\": %.3f, "
-                "\"scalar_worst_libcyl_over_memcpy\": %.3f, \"simd_bit_identical\": %s, \"simd_frames_compared\": %d}\n",
+                "\"scalar_worst_libcyl_over_memcpy\": %.3f, \"simd_bit_identical\": %s, \"simd_frames_compared\": %d, \"classify_us\": %.2f, "
+                "\"classify_over_segment\": %.3f}\n",
                 m_cyl, m_mem, m_cv, m_cyl / m_mem, m_cv / m_cyl, m_3d, m_3d / m_cyl, set_frac[0], set_ratio[1], set_frac[1],
                 set_ratio[2], worst, large[0].fps, large[1].fps, large[2].fps, large[3].fps, large[0].fps2, large[1].fps2, large[2].fps2,
                 large[3].fps2, cyl_segment_vector_path(),
-                scalar_ratio[0], std::max(scalar_ratio[1], scalar_ratio[2]), identical ? "true" : "false", compared);
+                scalar_ratio[0], std::max(scalar_ratio[1], scalar_ratio[2]), identical ? "true" : "false", compared, m_cls,
+                m_cls / m_cyl);
     return 0;
 }

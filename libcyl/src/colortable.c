@@ -168,28 +168,8 @@ unsigned cyl_mask_class(cyl_mask m)
     return i;
 }
 
-cyl_status cyl_classify(const cyl_colortable *t, const cyl_image *img, const cyl_roi *roi,
-                        unsigned x_step, unsigned y_step, uint8_t *out, size_t out_stride)
-{
-    cyl_roi r;
-    uint32_t x, y, i, j;
-    cyl_status s;
-    if (!t || !out) return CYL_ERR_ARG;
-    s = cyl_image_check(img);
-    if (s != CYL_OK) return s;
-    if (x_step == 0 || y_step == 0) return CYL_ERR_ARG;
-    if (!cyl_roi_resolve(img, roi, &r)) return CYL_ERR_SIZE;
-    if (out_stride < (r.width + x_step - 1u) / x_step) return CYL_ERR_SIZE;
-    for (j = 0, y = r.y; y < r.y + r.height; y += y_step, j++) {
-        uint8_t *o = out + (size_t)j * out_stride;
-        for (i = 0, x = r.x; x < r.x + r.width; x += x_step, i++) {
-            uint8_t Y, U, V;
-            cyl_pixel_fetch(img, x, y, &Y, &U, &V);
-            o[i] = (uint8_t)cyl_mask_class(cyl_colortable_mask(t, Y, U, V));
-        }
-    }
-    return CYL_OK;
-}
+/* cyl_classify() is in segment.c, beside the run-length encoder whose pixel access and
+ * background skip it shares. */
 
 /* ---- training ---------------------------------------------------------- */
 

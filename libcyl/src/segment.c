@@ -7,7 +7,7 @@
  *   written. For the 4:2:2 and 4:2:0 formats with x_step 1, the chroma pair
  *   of two neighbouring pixels is looked up once; when it maps to no class
  *   and no run is open, both pixels are skipped without touching Y. Where a
- *   vector path exists (chroma_skip.h: SSSE3, NEON), background is skipped
+ *   vector path exists (segment_vector.h: SSSE3, NEON), background is skipped
  *   16 pairs at a time on a coarse chroma map; pairs it cannot rule out go
  *   to the scalar code, so results are bit-identical to the scalar path.
  * - Runs are stored only for classified pixels (background is implicit).
@@ -18,7 +18,7 @@
 #include "cyl/segment.h"
 #include "internal.h"
 #include "lowbit.h"
-#include "chroma_skip.h"
+#include "segment_vector.h"
 
 /* cells from one brightness level of the 3-D table to the next */
 #define YUV_YSTRIDE (CYL_YUV_NC * CYL_YUV_NC)
@@ -163,8 +163,8 @@ static int emit(rle_ctx *c, uint32_t x, uint32_t y, uint32_t len, unsigned cls)
 CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t y,
                                 const uint8_t *yp, const unsigned ysz, const uint8_t *up,
                                 const uint8_t *vp, const unsigned cs, uint32_t x0, uint32_t x1,
-                                cyl_skip_fn skip, const uint8_t *su, const uint8_t *sv,
-                                const unsigned lookup)
+                                cyl_skip_fn skip, cyl_extend_fn extend, const uint8_t *sy,
+                                const uint8_t *su, const uint8_t *sv, const unsigned lookup)
 {
     const cyl_mask (*uv)[256] = t->uv;
     const cyl_mask *ytab = t->y;
@@ -192,7 +192,7 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
         if (cur == CYL_CLASS_NONE) {
             /* Background fast path: skip pairs whose chroma is in no class without
              * reading luma; 16 pairs at a time on the coarse chroma map where a vector
-             * path exists (chroma_skip.h), then two pairs at a time on uv itself. */
+             * path exists (segment_vector.h), then two pairs at a time on uv itself. */
             const uint8_t *pu = up + (x / 2u) * cs, *pv = vp + (x / 2u) * cs;
             if (uv[pu[0]][pv[0]] == 0) {
                 uint32_t xlim = x1;
@@ -212,9 +212,16 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
             m = uv[pu[0]][pv[0]];
             col = PAIR_COL(pu[0], pv[0]);
         } else {
-            const uint8_t U = up[(x / 2u) * cs], V = vp[(x / 2u) * cs];
-            m = uv[U][V];
-            col = PAIR_COL(U, V);
+            if (extend && x - start >= 4u) {
+                /* a run that has lasted two pairs: extend it 16 pixels at a time */
+                x = 2u * extend(t, sy, su, sv, x / 2u, x1 / 2u, cur);
+                if (x + 1u >= x1) break;
+            }
+            {
+                const uint8_t U = up[(x / 2u) * cs], V = vp[(x / 2u) * cs];
+                m = uv[U][V];
+                col = PAIR_COL(U, V);
+            }
         }
         STEP(PAIR_CLASS(yp[x * ysz]), x);
         STEP(PAIR_CLASS(yp[(x + 1u) * ysz]), x + 1u);
@@ -241,21 +248,21 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
     }
 static int encode_yuyv(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r, uint32_t x0, uint32_t x1)
 {
-    ENCODE_BY_LOOKUP(c, t, y, r, 2u, r + 1, r + 3, 4u, x0, x1, c->skip.yuyv, r, NULL)
+    ENCODE_BY_LOOKUP(c, t, y, r, 2u, r + 1, r + 3, 4u, x0, x1, c->skip.yuyv, c->skip.ext_yuyv, r, r, NULL)
 }
 static int encode_uyvy(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r, uint32_t x0, uint32_t x1)
 {
-    ENCODE_BY_LOOKUP(c, t, y, r + 1, 2u, r, r + 2, 4u, x0, x1, c->skip.uyvy, r, NULL)
+    ENCODE_BY_LOOKUP(c, t, y, r + 1, 2u, r, r + 2, 4u, x0, x1, c->skip.uyvy, c->skip.ext_uyvy, r, r, NULL)
 }
 static int encode_nv12(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r,
                        const uint8_t *uv, uint32_t x0, uint32_t x1)
 {
-    ENCODE_BY_LOOKUP(c, t, y, r, 1u, uv, uv + 1, 2u, x0, x1, c->skip.nv12, uv, NULL)
+    ENCODE_BY_LOOKUP(c, t, y, r, 1u, uv, uv + 1, 2u, x0, x1, c->skip.nv12, c->skip.ext_nv12, r, uv, NULL)
 }
 static int encode_i420(rle_ctx *c, const cyl_colortable *t, uint32_t y, const uint8_t *r,
                        const uint8_t *u, const uint8_t *v, uint32_t x0, uint32_t x1)
 {
-    ENCODE_BY_LOOKUP(c, t, y, r, 1u, u, v, 1u, x0, x1, c->skip.i420, u, v)
+    ENCODE_BY_LOOKUP(c, t, y, r, 1u, u, v, 1u, x0, x1, c->skip.i420, c->skip.ext_i420, r, u, v)
 }
 #undef ENCODE_BY_LOOKUP
 
@@ -296,6 +303,84 @@ static int encode_row(rle_ctx *ctx, const cyl_colortable *t, const cyl_image *im
         }
     }
     return encode_generic(ctx, t, img, y, x0, xs, n);
+}
+
+/* ---- class map (cyl_classify) ---------------------------------------------- */
+
+/* Class indices of samples [x0, x1) of a row of a 4:2:x format (layout as encode_pairs), into
+ * o[0, x1 - x0): a chroma pair that maps to no class is written as background without reading
+ * luma, and runs of such pairs are found by the vector skip where there is one. */
+CYL_HOT_INLINE void classify_pairs(const cyl_colortable *t, const uint8_t *yp, const unsigned ysz,
+                                   const uint8_t *up, const uint8_t *vp, const unsigned cs, uint32_t x0,
+                                   uint32_t x1, uint8_t *o, cyl_skip_fn skip, const uint8_t *su,
+                                   const uint8_t *sv)
+{
+    uint32_t x = x0;
+#define PIX_CLASS(X) cyl_lowbit[cyl_colortable_mask(t, yp[(X) * ysz], up[((X) / 2u) * cs], vp[((X) / 2u) * cs])]
+    if (x & 1u) { o[0] = PIX_CLASS(x); x++; }
+    while (x + 1u < x1) {
+        const uint8_t U = up[(x / 2u) * cs], V = vp[(x / 2u) * cs];
+        const cyl_mask m = t->uv[U][V];
+        if (m == 0) {
+            uint32_t xn = x + 2u, xlim = x1;
+            if (skip) {
+                xn = 2u * skip(su, sv, t->chroma_any, xn / 2u, x1 / 2u);
+                if (xn + 16u < x1) xlim = xn + 16u;   /* as in encode_pairs */
+            }
+            while (xn + 1u < xlim && t->uv[up[(xn / 2u) * cs]][vp[(xn / 2u) * cs]] == 0) xn += 2u;
+            memset(o + (x - x0), CYL_CLASS_NONE, xn - x);
+            x = xn;
+            continue;
+        }
+        {
+            const cyl_mask *col = &t->yuv[0][U >> CYL_YUV_CSHIFT][V >> CYL_YUV_CSHIFT];
+            const uint8_t Y0 = yp[x * ysz], Y1 = yp[(x + 1u) * ysz];
+            o[x - x0] = cyl_lowbit[m & t->y[Y0] & col[(unsigned)(Y0 >> CYL_YUV_YSHIFT) * YUV_YSTRIDE]];
+            o[x + 1u - x0] = cyl_lowbit[m & t->y[Y1] & col[(unsigned)(Y1 >> CYL_YUV_YSHIFT) * YUV_YSTRIDE]];
+        }
+        x += 2u;
+    }
+    if (x < x1) o[x - x0] = PIX_CLASS(x);
+#undef PIX_CLASS
+}
+
+cyl_status cyl_classify(const cyl_colortable *t, const cyl_image *img, const cyl_roi *roi,
+                        unsigned x_step, unsigned y_step, uint8_t *out, size_t out_stride)
+{
+    cyl_roi r;
+    uint32_t x, y, i, j;
+    cyl_status s;
+    const cyl_skip_set sk = cyl_skip_select();
+    if (!t || !out) return CYL_ERR_ARG;
+    s = cyl_image_check(img);
+    if (s != CYL_OK) return s;
+    if (x_step == 0 || y_step == 0) return CYL_ERR_ARG;
+    if (!cyl_roi_resolve(img, roi, &r)) return CYL_ERR_SIZE;
+    if (out_stride < (r.width + x_step - 1u) / x_step) return CYL_ERR_SIZE;
+    for (j = 0, y = r.y; y < r.y + r.height; y += y_step, j++) {
+        uint8_t *o = out + (size_t)j * out_stride;
+        const uint8_t *r0 = img->plane[0] + (size_t)y * img->stride[0];
+        const uint8_t *c1 = img->format == CYL_FMT_NV12 || img->format == CYL_FMT_I420
+                                ? img->plane[1] + (size_t)(y / 2u) * img->stride[1] : NULL;
+        const uint32_t x1 = r.x + r.width;
+        if (x_step == 1u && img->format == CYL_FMT_YUYV) {
+            classify_pairs(t, r0, 2u, r0 + 1, r0 + 3, 4u, r.x, x1, o, sk.yuyv, r0, NULL);
+        } else if (x_step == 1u && img->format == CYL_FMT_UYVY) {
+            classify_pairs(t, r0 + 1, 2u, r0, r0 + 2, 4u, r.x, x1, o, sk.uyvy, r0, NULL);
+        } else if (x_step == 1u && img->format == CYL_FMT_NV12) {
+            classify_pairs(t, r0, 1u, c1, c1 + 1, 2u, r.x, x1, o, sk.nv12, c1, NULL);
+        } else if (x_step == 1u && img->format == CYL_FMT_I420) {
+            const uint8_t *c2 = img->plane[2] + (size_t)(y / 2u) * img->stride[2];
+            classify_pairs(t, r0, 1u, c1, c2, 1u, r.x, x1, o, sk.i420, c1, c2);
+        } else {
+            for (i = 0, x = r.x; x < x1; x += x_step, i++) {
+                uint8_t Y, U, V;
+                cyl_pixel_fetch(img, x, y, &Y, &U, &V);
+                o[i] = cyl_lowbit[cyl_colortable_mask(t, Y, U, V)];
+            }
+        }
+    }
+    return CYL_OK;
 }
 
 /* ---- union-find ------------------------------------------------------------ */

@@ -511,6 +511,22 @@ static void test_bruteforce_random(void **state)
     free(ref);
 }
 
+/* Y, U, V of pixel (x, y), read here from each format's layout (independently of the library). */
+static void fetch_pixel(const cyl_image *img, uint32_t x, uint32_t y, uint8_t *Y, uint8_t *U, uint8_t *V)
+{
+    const uint8_t *r0 = img->plane[0] + (size_t)y * img->stride[0];
+    const uint8_t *c1 = img->plane[1] + (size_t)(y / 2u) * img->stride[1];
+    switch (img->format) {
+    case CYL_FMT_YUYV: *Y = r0[2u * x]; *U = r0[(x & ~1u) * 2u + 1u]; *V = r0[(x & ~1u) * 2u + 3u]; break;
+    case CYL_FMT_UYVY: *Y = r0[2u * x + 1u]; *U = r0[(x & ~1u) * 2u]; *V = r0[(x & ~1u) * 2u + 2u]; break;
+    case CYL_FMT_NV12: *Y = r0[x]; *U = c1[x & ~1u]; *V = c1[(x & ~1u) + 1u]; break;
+    case CYL_FMT_I420:
+        *Y = r0[x]; *U = c1[x / 2u]; *V = img->plane[2][(size_t)(y / 2u) * img->stride[2] + x / 2u];
+        break;
+    default: *Y = *U = *V = 0; break;
+    }
+}
+
 /* The coarse chroma map equals its definition (computed here from uv by brute force)
  * after every kind of table edit. */
 static void check_chroma_map(const cyl_colortable *t)
@@ -605,12 +621,34 @@ static void test_vector_path_identical(void **state)
             col[k][1] = (uint8_t)(u0 + du / 2);
             col[k][2] = (uint8_t)(v0 + dv / 2);
         }
-        if (test_rng_int(&rng, 0, 2) == 0) {   /* a brightness-dependent part too */
+        switch (iter % 3) {
+        case 1: {   /* a brightness-dependent part too (lookup: uv, y and yuv) */
             unsigned yc, uc, vc;
             for (yc = 0; yc < CYL_YUV_NY; yc += 2)
                 for (uc = 0; uc < CYL_YUV_NC; uc++)
                     for (vc = 0; vc < CYL_YUV_NC; vc++) t.yuv[yc][uc][vc] &= (cyl_mask)~1u;
             cyl_colortable_refresh(&t);
+            break;
+        }
+        case 2: {   /* the learned form: whole chroma cells in uv, y all ones, yuv decides (lookup: yuv) */
+            unsigned yc, u, v;
+            memset(t.y, 0xFF, sizeof t.y);
+            for (u = 0; u < 256; u++)
+                for (v = 0; v < 256; v++) {
+                    cyl_mask cell = 0;
+                    unsigned du, dv;
+                    for (du = 0; du < 4u; du++)
+                        for (dv = 0; dv < 4u; dv++) cell |= t.uv[(u & ~3u) + du][(v & ~3u) + dv];
+                    t.uv[u][v] = cell;
+                    for (yc = 0; yc < CYL_YUV_NY; yc++)
+                        t.yuv[yc][u >> 2][v >> 2] = (cyl_mask)((yc % 3u) == 0 ? 0 : cell);
+                }
+            cyl_colortable_refresh(&t);
+            assert_int_equal(t.lookup, CYL_LOOKUP_YUV);
+            break;
+        }
+        default:
+            break;
         }
         assert_true(canvas_alloc(&c, w, h));
         for (j = 0; j < h; j++)
@@ -654,6 +692,24 @@ static void test_vector_path_identical(void **state)
         assert_memory_equal(sa.runs, sb.runs, sizeof(cyl_run) * sa.n_runs);
         assert_memory_equal(sa.blobs, sb.blobs, sizeof(cyl_blob) * sa.n_blobs);
         total_runs += sa.n_runs;
+        /* the class map (cyl_classify, whose 4:2:x path shares the vector skip) pixel by pixel */
+        {
+            cyl_roi roi = p.roi;
+            uint32_t rw, rh, x, yy;
+            uint8_t *cls;
+            if (roi.width == 0) { roi.x = 0; roi.y = 0; roi.width = w; roi.height = h; }
+            rw = roi.width; rh = roi.height;
+            cls = (uint8_t *)malloc((size_t)rw * rh + 1);
+            assert_int_equal(cyl_classify(&t, &img, &roi, 1, 1, cls, rw), CYL_OK);
+            for (yy = 0; yy < rh; yy++)
+                for (x = 0; x < rw; x++) {
+                    uint8_t Y, U, V;
+                    fetch_pixel(&img, roi.x + x, roi.y + yy, &Y, &U, &V);
+                    if (cls[(size_t)yy * rw + x] != cyl_mask_class(cyl_colortable_mask(&t, Y, U, V)))
+                        fail_msg("classify: frame %d pixel (%u, %u)", iter, roi.x + x, roi.y + yy);
+                }
+            free(cls);
+        }
         free(buf);
         canvas_free(&c);
     }

@@ -23,8 +23,8 @@
  * pairs are left it stops and returns the first pair it did not examine. It reads only
  * the chroma bytes of pairs [p, q] rounded up to its block: no byte past pair n - 1.
  */
-#ifndef CYL_CHROMA_SKIP_H
-#define CYL_CHROMA_SKIP_H
+#ifndef CYL_SEGMENT_VECTOR_H
+#define CYL_SEGMENT_VECTOR_H
 
 #include <stdint.h>
 #include "cyl/colortable.h"
@@ -34,8 +34,16 @@
 typedef uint32_t (*cyl_skip_fn)(const uint8_t *u, const uint8_t *v, const uint8_t (*map)[16],
                                 uint32_t p, uint32_t n);
 
+/* Run extension (AVX2 only: it needs gathers): with a run of class cur open at pair p, the first
+ * pair index q in [p, n) at which some pixel is not of class cur, examining 8 pairs (16 pixels)
+ * at a time; when fewer than 8 pairs are left it returns the first pair it did not examine.
+ * y: the luma row (packed formats: the row), u, v: as for cyl_skip_fn. */
+typedef uint32_t (*cyl_extend_fn)(const cyl_colortable *t, const uint8_t *y, const uint8_t *u,
+                                  const uint8_t *v, uint32_t p, uint32_t n, unsigned cur);
+
 typedef struct cyl_skip_set {
     cyl_skip_fn yuyv, uyvy, nv12, i420;
+    cyl_extend_fn ext_yuyv, ext_uyvy, ext_nv12, ext_i420;
     const char *name;
 } cyl_skip_set;
 
@@ -216,6 +224,79 @@ CYL_SKIP_TARGET_AVX2 static uint32_t cyl_skip_i420_avx2(const uint8_t *u, const 
     return cyl_skip_i420_ssse3(u, v, map, p, n);
 }
 
+/* Class masks of 16 pixels (even pixels Y0, odd Y1; chroma U, V per pair; 32-bit lanes) by the
+ * table's rule (cyl_colortable_mask, with t->lookup's parts), compared with class cur: bit i of
+ * the result set when pair i has a pixel of another class. The gathers read 4 bytes from each
+ * entry, so up to 3 bytes after a table: still inside cyl_colortable (y follows uv, yuv follows
+ * y, lookup and weak_of follow yuv). */
+CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_run_breaks(const cyl_colortable *t, __m256i Y0, __m256i Y1,
+                                                           __m256i U, __m256i V, unsigned cur)
+{
+    const __m256i low = _mm256_set1_epi32((int)((2u << cur) - 1u)), bit = _mm256_set1_epi32((int)(1u << cur));
+    __m256i m0, m1;
+    unsigned ok;
+    if (t->lookup & CYL_LOOKUP_UV_Y) {
+        const __m256i muv = _mm256_i32gather_epi32((const int *)(const void *)&t->uv[0][0],
+                                                   _mm256_or_si256(_mm256_slli_epi32(U, 8), V), 1);
+        m0 = _mm256_and_si256(muv, _mm256_i32gather_epi32((const int *)(const void *)t->y, Y0, 1));
+        m1 = _mm256_and_si256(muv, _mm256_i32gather_epi32((const int *)(const void *)t->y, Y1, 1));
+    } else {
+        m0 = m1 = _mm256_set1_epi32(t->live);
+    }
+    if (t->lookup & CYL_LOOKUP_YUV) {
+        const int *yuv = (const int *)(const void *)&t->yuv[0][0][0];
+        const __m256i c = _mm256_or_si256(_mm256_slli_epi32(_mm256_srli_epi32(U, CYL_YUV_CSHIFT), 6),
+                                          _mm256_srli_epi32(V, CYL_YUV_CSHIFT));
+        m0 = _mm256_and_si256(m0, _mm256_i32gather_epi32(yuv, _mm256_or_si256(c, _mm256_slli_epi32(
+                                      _mm256_srli_epi32(Y0, CYL_YUV_YSHIFT), 12)), 1));
+        m1 = _mm256_and_si256(m1, _mm256_i32gather_epi32(yuv, _mm256_or_si256(c, _mm256_slli_epi32(
+                                      _mm256_srli_epi32(Y1, CYL_YUV_YSHIFT), 12)), 1));
+    }
+    /* lowest set bit == cur  <=>  (mask & ((2 << cur) - 1)) == 1 << cur */
+    ok = (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(m0, low), bit))) &
+         (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(m1, low), bit)));
+    return ~ok & 0xFFu;
+}
+
+#define CYL_EXTEND_AVX2(NAME, LOAD)                                                            \
+    CYL_SKIP_TARGET_AVX2 static uint32_t NAME(const cyl_colortable *t, const uint8_t *y,       \
+                                              const uint8_t *u, const uint8_t *v, uint32_t p,  \
+                                              uint32_t n, unsigned cur)                        \
+    {                                                                                          \
+        const __m256i ff = _mm256_set1_epi32(0xFF);                                            \
+        (void)u; (void)v; (void)ff;                                                            \
+        for (; p + 8u <= n; p += 8u) {                                                         \
+            __m256i Y0, Y1, U, V;                                                              \
+            unsigned b;                                                                        \
+            LOAD                                                                               \
+            b = cyl_run_breaks(t, Y0, Y1, U, V, cur);                                          \
+            if (b) { _mm256_zeroupper(); return p + (uint32_t)__builtin_ctz(b); }              \
+        }                                                                                      \
+        _mm256_zeroupper();                                                                    \
+        return p;                                                                              \
+    }
+/* packed: each 32-bit lane is one pair's 4 bytes */
+CYL_EXTEND_AVX2(cyl_extend_yuyv_avx2, {
+    const __m256i w = _mm256_loadu_si256((const __m256i *)(const void *)(y + 4u * (size_t)p));
+    Y0 = _mm256_and_si256(w, ff); U = _mm256_and_si256(_mm256_srli_epi32(w, 8), ff);
+    Y1 = _mm256_and_si256(_mm256_srli_epi32(w, 16), ff); V = _mm256_srli_epi32(w, 24); })
+CYL_EXTEND_AVX2(cyl_extend_uyvy_avx2, {
+    const __m256i w = _mm256_loadu_si256((const __m256i *)(const void *)(y + 4u * (size_t)p));
+    U = _mm256_and_si256(w, ff); Y0 = _mm256_and_si256(_mm256_srli_epi32(w, 8), ff);
+    V = _mm256_and_si256(_mm256_srli_epi32(w, 16), ff); Y1 = _mm256_srli_epi32(w, 24); })
+/* planar luma: 16 bytes widened to 8 lanes of two pixels each */
+CYL_EXTEND_AVX2(cyl_extend_nv12_avx2, {
+    const __m256i l = _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(y + 2u * (size_t)p)));
+    const __m256i c = _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(u + 2u * (size_t)p)));
+    Y0 = _mm256_and_si256(l, ff); Y1 = _mm256_srli_epi32(l, 8);
+    U = _mm256_and_si256(c, ff); V = _mm256_srli_epi32(c, 8); })
+CYL_EXTEND_AVX2(cyl_extend_i420_avx2, {
+    const __m256i l = _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(y + 2u * (size_t)p)));
+    Y0 = _mm256_and_si256(l, ff); Y1 = _mm256_srli_epi32(l, 8);
+    U = _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(const void *)(u + p)));
+    V = _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(const void *)(v + p))); })
+#undef CYL_EXTEND_AVX2
+
 /* CYL_SKIP_MAX_X86 (build option): 1 = SSSE3 at most, 2 = AVX2 at most (default). */
 #ifndef CYL_SKIP_MAX_X86
 #define CYL_SKIP_MAX_X86 2
@@ -241,12 +322,16 @@ static inline int cyl_skip_have_ssse3(void)
 
 static inline cyl_skip_set cyl_skip_select(void)
 {
-    cyl_skip_set s = { 0, 0, 0, 0, "scalar" };
+    cyl_skip_set s = { 0, 0, 0, 0, 0, 0, 0, 0, "scalar" };
     if (cyl_skip_have_avx2()) {
         s.yuyv = cyl_skip_yuyv_avx2;
         s.uyvy = cyl_skip_uyvy_avx2;
         s.nv12 = cyl_skip_nv12_avx2;
         s.i420 = cyl_skip_i420_avx2;
+        s.ext_yuyv = cyl_extend_yuyv_avx2;
+        s.ext_uyvy = cyl_extend_uyvy_avx2;
+        s.ext_nv12 = cyl_extend_nv12_avx2;
+        s.ext_i420 = cyl_extend_i420_avx2;
         s.name = "avx2";
     } else if (cyl_skip_have_ssse3()) {
         s.yuyv = cyl_skip_yuyv_ssse3;
@@ -309,16 +394,17 @@ CYL_SKIP_NEON_FN(cyl_skip_i420_neon, { un = vld1q_u8(u + p); vn = vld1q_u8(v + p
 
 static inline cyl_skip_set cyl_skip_select(void)
 {
-    cyl_skip_set s = { cyl_skip_yuyv_neon, cyl_skip_uyvy_neon, cyl_skip_nv12_neon, cyl_skip_i420_neon, "neon" };
+    cyl_skip_set s = { cyl_skip_yuyv_neon, cyl_skip_uyvy_neon, cyl_skip_nv12_neon, cyl_skip_i420_neon,
+                       0, 0, 0, 0, "neon" };
     return s;
 }
 
 #else
 static inline cyl_skip_set cyl_skip_select(void)
 {
-    cyl_skip_set s = { 0, 0, 0, 0, "scalar" };
+    cyl_skip_set s = { 0, 0, 0, 0, 0, 0, 0, 0, "scalar" };
     return s;
 }
 #endif
 
-#endif /* CYL_CHROMA_SKIP_H */
+#endif /* CYL_SEGMENT_VECTOR_H */
