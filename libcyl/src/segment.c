@@ -116,6 +116,8 @@ typedef struct rle_ctx {
     uint32_t min_run;
     int full;
     cyl_skip_set skip;    /* vector background skip per format (NULL: scalar only) */
+    uint32_t skip_rest;   /* rows still to encode without the vector skip / run extension, */
+    uint32_t extend_rest; /* after a row in which they did not pay (performance only) */
 } rle_ctx;
 
 static int emit(rle_ctx *c, uint32_t x, uint32_t y, uint32_t len, unsigned cls)
@@ -170,8 +172,11 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
     const cyl_mask *ytab = t->y;
     const cyl_mask *yuv = &t->yuv[0][0][0];
     const cyl_mask live = t->live;
-    unsigned cur = CYL_CLASS_NONE;
+    unsigned cur = CYL_CLASS_NONE, skip_misses = 2u, extend_misses = 16u;
     uint32_t x = x0, start = x0, x_img0 = 0, xs = 1;
+    /* a row after one where the vector code did not pay goes without it; every 8th tries again */
+    if (ctx->skip_rest) { ctx->skip_rest--; skip = NULL; }
+    if (ctx->extend_rest) { ctx->extend_rest--; extend = NULL; }
     /* Class of luma Y given the pair's chroma mask m and its 3-D column col. */
     /* lookup (a constant in each inlined copy) leaves out the parts that never reject */
 #define PAIR_CLASS(Y)                                                                         \
@@ -197,11 +202,24 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
             if (uv[pu[0]][pv[0]] == 0) {
                 uint32_t xlim = x1;
                 x += 2u;
+                /* the scalar test first, for up to 4 pairs: short gaps between runs are
+                 * cheaper to walk than to hand to the vector code */
                 if (skip) {
+                    const uint32_t xw = x + 8u < x1 ? x + 8u : x1;
+                    pu = up + (x / 2u) * cs; pv = vp + (x / 2u) * cs;
+                    while (x + 1u < xw && uv[pu[0]][pv[0]] == 0) { x += 2u; pu += cs; pv += cs; }
+                    if (x + 1u < xw) continue;   /* a pair that may be coloured */
+                }
+                if (skip && x + 1u < x1) {
+                    const uint32_t xs0 = x;
                     x = 2u * skip(su, sv, t->chroma_any, x / 2u, x1 / 2u);
                     /* a block bit may be set by another chroma of the block: the scalar
                      * test runs for a few pairs only before the vector one takes over */
                     if (x + 16u < x1) xlim = x + 16u;
+                    /* where the background's chroma keeps falling in blocks the map cannot
+                     * rule out, the vector skip costs more than it saves: the rest of the
+                     * row goes without it */
+                    if (x - xs0 < 32u && --skip_misses == 0) { skip = NULL; ctx->skip_rest = 7u; }
                 }
                 pu = up + (x / 2u) * cs; pv = vp + (x / 2u) * cs;
                 while (x + 3u < xlim && (uv[pu[0]][pv[0]] | uv[pu[cs]][pv[cs]]) == 0) {
@@ -213,8 +231,11 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
             col = PAIR_COL(pu[0], pv[0]);
         } else {
             if (extend && x - start >= 4u) {
-                /* a run that has lasted two pairs: extend it 16 pixels at a time */
+                /* a run that has lasted two pairs: extend it 16 pixels at a time (and, as
+                 * with the skip, stop trying in a row where runs keep breaking early) */
+                const uint32_t xe0 = x;
                 x = 2u * extend(t, sy, su, sv, x / 2u, x1 / 2u, cur);
+                if (x - xe0 < 16u && --extend_misses == 0) { extend = NULL; ctx->extend_rest = 3u; }
                 if (x + 1u >= x1) break;
             }
             {
@@ -607,6 +628,8 @@ static void rle_begin(rle_ctx *ctx, cyl_run *runs, uint32_t max_runs, const cyl_
     ctx->max = max_runs;
     ctx->min_run = p->min_run_px;
     ctx->full = 0;
+    ctx->skip_rest = 0;
+    ctx->extend_rest = 0;
     if (p->scalar_only) {
         memset(&ctx->skip, 0, sizeof ctx->skip);
     } else {
