@@ -174,7 +174,9 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
     const cyl_mask live = t->live;
     unsigned cur = CYL_CLASS_NONE, skip_misses = 2u, extend_misses = 16u;
     uint32_t x = x0, start = x0, x_img0 = 0, xs = 1;
-    /* a row after one where the vector code did not pay goes without it; every 8th tries again */
+    /* rows after one where the vector code did not pay go without it: the next 7 rows without
+     * the skip, the next 3 without the run extension (performance only: results never depend
+     * on which path ran) */
     if (ctx->skip_rest) { ctx->skip_rest--; skip = NULL; }
     if (ctx->extend_rest) { ctx->extend_rest--; extend = NULL; }
     /* Class of luma Y given the pair's chroma mask m and its 3-D column col. */
@@ -218,7 +220,7 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
                     if (x + 16u < x1) xlim = x + 16u;
                     /* where the background's chroma keeps falling in blocks the map cannot
                      * rule out, the vector skip costs more than it saves: the rest of the
-                     * row goes without it */
+                     * row (and the next rows, above) goes without it */
                     if (x - xs0 < 32u && --skip_misses == 0) { skip = NULL; ctx->skip_rest = 7u; }
                 }
                 pu = up + (x / 2u) * cs; pv = vp + (x / 2u) * cs;
