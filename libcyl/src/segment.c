@@ -157,6 +157,47 @@ static int emit(rle_ctx *c, uint32_t x, uint32_t y, uint32_t len, unsigned cls)
 #define CYL_HOT_INLINE static inline
 #endif
 
+/* The vector background skip of one row: its function (NULL: scalar only), the chroma pointers
+ * it reads, how many more short skips it may make before the row goes without it, and where to
+ * say for how many further rows it should stay off. */
+typedef struct bg_skip {
+    cyl_skip_fn fn;
+    const uint8_t *su, *sv;
+    unsigned misses;
+    uint32_t *rest_rows;
+} bg_skip;
+
+/* Background pairs from sample x (even offset from the row's pairs) on: returns the first x' >= x
+ * such that every pair in [x, x') has uv == 0 (and x' + 1 < x1 where a pair may be coloured).
+ * Short gaps are walked by the scalar test (4 pairs); longer ones by the vector skip on the coarse
+ * chroma map, then the scalar test again for at most 8 pairs, since a block bit may be set by
+ * another chroma of the block. Where the background's chroma keeps falling in blocks the map
+ * cannot rule out, the vector skip costs more than it saves: after two short skips it is off for
+ * the rest of the row and the next 7 rows. */
+CYL_HOT_INLINE uint32_t skip_background(const cyl_colortable *t, const uint8_t *up, const uint8_t *vp,
+                                        const unsigned cs, uint32_t x, uint32_t x1, bg_skip *sk)
+{
+    const cyl_mask (*uv)[256] = t->uv;
+    const uint8_t *pu = up + (x / 2u) * cs, *pv = vp + (x / 2u) * cs;
+    uint32_t xlim = x1;
+    if (sk->fn) {
+        const uint32_t xw = x + 8u < x1 ? x + 8u : x1;
+        while (x + 1u < xw && uv[pu[0]][pv[0]] == 0) { x += 2u; pu += cs; pv += cs; }
+        if (x + 1u < xw) return x;   /* a pair that may be coloured */
+        if (x + 1u < x1) {
+            const uint32_t xs0 = x;
+            x = 2u * sk->fn(sk->su, sk->sv, t->chroma_any, x / 2u, x1 / 2u);
+            if (x + 16u < x1) xlim = x + 16u;
+            if (x - xs0 < 32u && --sk->misses == 0) { sk->fn = NULL; *sk->rest_rows = 7u; }
+            pu = up + (x / 2u) * cs; pv = vp + (x / 2u) * cs;
+        }
+    }
+    while (x + 3u < xlim && (uv[pu[0]][pv[0]] | uv[pu[cs]][pv[cs]]) == 0) {
+        x += 4u; pu += 2u * cs; pv += 2u * cs;
+    }
+    return x;
+}
+
 /* Samples [x0, x1) of a row of a format whose two horizontal neighbours
  * (even x, x+1) share chroma. yp: luma row, ysz: bytes per luma sample;
  * up/vp: chroma of pair 0 (pixel 0), cs: bytes from one chroma pair to the next.
@@ -172,12 +213,14 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
     const cyl_mask *ytab = t->y;
     const cyl_mask *yuv = &t->yuv[0][0][0];
     const cyl_mask live = t->live;
-    unsigned cur = CYL_CLASS_NONE, skip_misses = 2u, extend_misses = 16u;
+    unsigned cur = CYL_CLASS_NONE, extend_misses = 16u;
     uint32_t x = x0, start = x0, x_img0 = 0, xs = 1;
+    bg_skip sk;
     /* rows after one where the vector code did not pay go without it: the next 7 rows without
      * the skip, the next 3 without the run extension (performance only: results never depend
      * on which path ran) */
-    if (ctx->skip_rest) { ctx->skip_rest--; skip = NULL; }
+    sk.fn = skip; sk.su = su; sk.sv = sv; sk.misses = 2u; sk.rest_rows = &ctx->skip_rest;
+    if (ctx->skip_rest) { ctx->skip_rest--; sk.fn = NULL; }
     if (ctx->extend_rest) { ctx->extend_rest--; extend = NULL; }
     /* Class of luma Y given the pair's chroma mask m and its 3-D column col. */
     /* lookup (a constant in each inlined copy) leaves out the parts that never reject */
@@ -198,35 +241,10 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
         const cyl_mask *col;
         if (cur == CYL_CLASS_NONE) {
             /* Background fast path: skip pairs whose chroma is in no class without
-             * reading luma; 16 pairs at a time on the coarse chroma map where a vector
-             * path exists (segment_vector.h), then two pairs at a time on uv itself. */
+             * reading luma (skip_background). */
             const uint8_t *pu = up + (x / 2u) * cs, *pv = vp + (x / 2u) * cs;
             if (uv[pu[0]][pv[0]] == 0) {
-                uint32_t xlim = x1;
-                x += 2u;
-                /* the scalar test first, for up to 4 pairs: short gaps between runs are
-                 * cheaper to walk than to hand to the vector code */
-                if (skip) {
-                    const uint32_t xw = x + 8u < x1 ? x + 8u : x1;
-                    pu = up + (x / 2u) * cs; pv = vp + (x / 2u) * cs;
-                    while (x + 1u < xw && uv[pu[0]][pv[0]] == 0) { x += 2u; pu += cs; pv += cs; }
-                    if (x + 1u < xw) continue;   /* a pair that may be coloured */
-                }
-                if (skip && x + 1u < x1) {
-                    const uint32_t xs0 = x;
-                    x = 2u * skip(su, sv, t->chroma_any, x / 2u, x1 / 2u);
-                    /* a block bit may be set by another chroma of the block: the scalar
-                     * test runs for a few pairs only before the vector one takes over */
-                    if (x + 16u < x1) xlim = x + 16u;
-                    /* where the background's chroma keeps falling in blocks the map cannot
-                     * rule out, the vector skip costs more than it saves: the rest of the
-                     * row (and the next rows, above) goes without it */
-                    if (x - xs0 < 32u && --skip_misses == 0) { skip = NULL; ctx->skip_rest = 7u; }
-                }
-                pu = up + (x / 2u) * cs; pv = vp + (x / 2u) * cs;
-                while (x + 3u < xlim && (uv[pu[0]][pv[0]] | uv[pu[cs]][pv[cs]]) == 0) {
-                    x += 4u; pu += 2u * cs; pv += 2u * cs;
-                }
+                x = skip_background(t, up, vp, cs, x + 2u, x1, &sk);
                 continue;
             }
             m = uv[pu[0]][pv[0]];
@@ -332,11 +350,10 @@ static int encode_row(rle_ctx *ctx, const cyl_colortable *t, const cyl_image *im
 
 /* Class indices of samples [x0, x1) of a row of a 4:2:x format (layout as encode_pairs), into
  * o[0, x1 - x0): a chroma pair that maps to no class is written as background without reading
- * luma, and runs of such pairs are found by the vector skip where there is one. */
+ * luma, and stretches of such pairs are found by skip_background, as in the segmentation. */
 CYL_HOT_INLINE void classify_pairs(const cyl_colortable *t, const uint8_t *yp, const unsigned ysz,
                                    const uint8_t *up, const uint8_t *vp, const unsigned cs, uint32_t x0,
-                                   uint32_t x1, uint8_t *o, cyl_skip_fn skip, const uint8_t *su,
-                                   const uint8_t *sv)
+                                   uint32_t x1, uint8_t *o, bg_skip *sk)
 {
     uint32_t x = x0;
 #define PIX_CLASS(X) cyl_lowbit[cyl_colortable_mask(t, yp[(X) * ysz], up[((X) / 2u) * cs], vp[((X) / 2u) * cs])]
@@ -345,12 +362,7 @@ CYL_HOT_INLINE void classify_pairs(const cyl_colortable *t, const uint8_t *yp, c
         const uint8_t U = up[(x / 2u) * cs], V = vp[(x / 2u) * cs];
         const cyl_mask m = t->uv[U][V];
         if (m == 0) {
-            uint32_t xn = x + 2u, xlim = x1;
-            if (skip) {
-                xn = 2u * skip(su, sv, t->chroma_any, xn / 2u, x1 / 2u);
-                if (xn + 16u < x1) xlim = xn + 16u;   /* as in encode_pairs */
-            }
-            while (xn + 1u < xlim && t->uv[up[(xn / 2u) * cs]][vp[(xn / 2u) * cs]] == 0) xn += 2u;
+            const uint32_t xn = skip_background(t, up, vp, cs, x + 2u, x1, sk);
             memset(o + (x - x0), CYL_CLASS_NONE, xn - x);
             x = xn;
             continue;
@@ -373,7 +385,8 @@ cyl_status cyl_classify(const cyl_colortable *t, const cyl_image *img, const cyl
     cyl_roi r;
     uint32_t x, y, i, j;
     cyl_status s;
-    const cyl_skip_set sk = cyl_skip_select();
+    const cyl_skip_set set = cyl_skip_select();
+    uint32_t skip_rest = 0;   /* as rle_ctx.skip_rest */
     if (!t || !out) return CYL_ERR_ARG;
     s = cyl_image_check(img);
     if (s != CYL_OK) return s;
@@ -386,15 +399,22 @@ cyl_status cyl_classify(const cyl_colortable *t, const cyl_image *img, const cyl
         const uint8_t *c1 = img->format == CYL_FMT_NV12 || img->format == CYL_FMT_I420
                                 ? img->plane[1] + (size_t)(y / 2u) * img->stride[1] : NULL;
         const uint32_t x1 = r.x + r.width;
+        bg_skip sk;
+        sk.misses = 2u;
+        sk.rest_rows = &skip_rest;
+        sk.su = img->format == CYL_FMT_YUYV || img->format == CYL_FMT_UYVY ? r0 : c1;
+        sk.sv = img->format == CYL_FMT_I420 ? img->plane[2] + (size_t)(y / 2u) * img->stride[2] : NULL;
+        sk.fn = img->format == CYL_FMT_YUYV ? set.yuyv : img->format == CYL_FMT_UYVY ? set.uyvy
+              : img->format == CYL_FMT_NV12 ? set.nv12 : set.i420;
+        if (skip_rest) { skip_rest--; sk.fn = NULL; }
         if (x_step == 1u && img->format == CYL_FMT_YUYV) {
-            classify_pairs(t, r0, 2u, r0 + 1, r0 + 3, 4u, r.x, x1, o, sk.yuyv, r0, NULL);
+            classify_pairs(t, r0, 2u, r0 + 1, r0 + 3, 4u, r.x, x1, o, &sk);
         } else if (x_step == 1u && img->format == CYL_FMT_UYVY) {
-            classify_pairs(t, r0 + 1, 2u, r0, r0 + 2, 4u, r.x, x1, o, sk.uyvy, r0, NULL);
+            classify_pairs(t, r0 + 1, 2u, r0, r0 + 2, 4u, r.x, x1, o, &sk);
         } else if (x_step == 1u && img->format == CYL_FMT_NV12) {
-            classify_pairs(t, r0, 1u, c1, c1 + 1, 2u, r.x, x1, o, sk.nv12, c1, NULL);
+            classify_pairs(t, r0, 1u, c1, c1 + 1, 2u, r.x, x1, o, &sk);
         } else if (x_step == 1u && img->format == CYL_FMT_I420) {
-            const uint8_t *c2 = img->plane[2] + (size_t)(y / 2u) * img->stride[2];
-            classify_pairs(t, r0, 1u, c1, c2, 1u, r.x, x1, o, sk.i420, c1, c2);
+            classify_pairs(t, r0, 1u, c1, sk.sv, 1u, r.x, x1, o, &sk);
         } else {
             for (i = 0, x = r.x; x < x1; x += x_step, i++) {
                 uint8_t Y, U, V;
