@@ -277,6 +277,7 @@ void ObservationLog::frame(uint64_t seq, int64_t t_ns, const std::vector<cyl_obs
         cf += ",";
         cf += num(o.cov_rb_frame[1][1]);
         l.raw("jac_calib", jm + "]").raw("cov_frame", cf + "]");
+        l.raw("bias_var_px2", "[" + num(o.bias_var_u_px2) + "," + num(o.bias_var_v_px2) + "]");
         write(l.done());
     }
     std::fflush(f_);

@@ -253,6 +253,7 @@ def observe(table: Table, frame: np.ndarray, fmt: str, camera: Camera,
             "confidence": o.confidence, "u_px": o.u_px, "v_px": o.v_px, "var_u_px2": o.var_u_px2,
             "var_v_px2": o.var_v_px2, "area_px": o.area, "flags": o.flags, "bbox_px": [b.x0, b.y0, b.x1, b.y1],
             "cov_frame": [o.cov_rb_frame[0][0], o.cov_rb_frame[0][1], o.cov_rb_frame[1][1]],
+            "bias_var_px2": [o.bias_var_u_px2, o.bias_var_v_px2],
         })
     del keep
     return out

@@ -53,6 +53,8 @@ SCHEMAS: Dict[str, dict] = {
         "flags": {"type": "integer"}, "bbox_px": {"type": "array", "items": {"type": "integer"},
                                                   "description": "x0 y0 x1 y1, px, inclusive"},
         "jac_calib": {"type": "array", "items": NUM}, "cov_frame": {"type": "array", "items": NUM},
+        "bias_var_px2": {"type": "array", "items": NUM,
+                         "description": "u, v variance of the centroid's residual bias (part of cov_frame), px^2"},
     }, ["seq", "class", "range_m", "bearing_rad", "cov_rr", "cov_rb", "cov_bb"]),
     "odom": _obj("cyl.Odometry", "pose increment since the previous one, in its frame (a BetweenFactor<Pose2>)", {
         "seq": {"type": "integer"}, "t": _n("s"), "dx_m": _n("m"), "dy_m": _n("m"), "dtheta_rad": _n("rad"),
