@@ -21,10 +21,9 @@ $(VENV)/.stamp: slam_demo/requirements.txt $(STAMP)/debs-py
 	touch $@
 
 TEST_EXTRA += $(VENV)/.stamp
-# pure Python: make test SAN=1 (the sanitizer run) has nothing to instrument in it and skips it
-ifneq ($(SAN),1)
 TEST_EXTRA_BINS += pytest:slam_demo/run_tests.sh
-endif
+# pure Python: nothing in it for the sanitizers
+SAN_SKIP += pytest:slam_demo/run_tests.sh
 
 .PHONY: slam-venv slam-test slam-synth mrclam victoria slam-run
 slam-venv: $(VENV)/.stamp
@@ -52,10 +51,9 @@ slam-run: $(VENV)/.stamp
 # the Python binding of the core (python/cyl, cffi): built in place and tested in make test;
 # make pip-check installs the repository into a fresh venv the way a newcomer does (needs PyPI)
 TEST_EXTRA += $(BUILD)/cyl $(BUILD)/cyl-render
-# its extension is built by cffi without the sanitizer flags: skipped by make test SAN=1
-ifneq ($(SAN),1)
 TEST_EXTRA_BINS += pytest:python/run_tests.sh
-endif
+# cffi builds its extension without the sanitizer flags
+SAN_SKIP += pytest:python/run_tests.sh
 pip-check:
 	@scripts/pip-check.sh
 .PHONY: pip-check
