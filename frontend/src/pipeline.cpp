@@ -111,10 +111,13 @@ bool blob_passes(const DetectorConfig &cfg, const cyl_blob &b, uint32_t frame_wi
     const ClassGate &g = cfg.gate[b.cls];
     if (g.max_area_px && b.area > g.max_area_px) return false;
     const double w = (double)(b.x1 - b.x0 + 1u), h = (double)(b.y1 - b.y0 + 1u);
-    if (!(b.flags & CYL_BLOB_TOUCH_ANY)) {
-        if (g.aspect_min > 0 && w < g.aspect_min * h) return false;
-        if (g.aspect_max > 0 && w > g.aspect_max * h) return false;
-    }
+    // A blob cut by the frame's left or right edge is at least as wide as it looks (its true
+    // aspect is no smaller), one cut at the top or bottom at least as tall (no larger): each
+    // side of the gate applies where the cut cannot have caused the failure.
+    const bool width_cut = (b.flags & (CYL_BLOB_TOUCH_LEFT | CYL_BLOB_TOUCH_RIGHT)) != 0;
+    const bool height_cut = (b.flags & (CYL_BLOB_TOUCH_TOP | CYL_BLOB_TOUCH_BOTTOM)) != 0;
+    if (g.aspect_min > 0 && !width_cut && w < g.aspect_min * h) return false;
+    if (g.aspect_max > 0 && !height_cut && w > g.aspect_max * h) return false;
     if (g.min_fill > 0 && (double)b.area < g.min_fill * w * h) return false;
     if (!cfg.mask.empty() && cfg.mask_width == frame_width && cfg.mask_height == frame_height) {
         long x = std::lround(b.cx_px), y = std::lround(b.cy_px);

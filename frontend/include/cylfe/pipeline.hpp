@@ -21,7 +21,9 @@ namespace cylfe {
 struct ClassGate {
     uint32_t max_area_px = 0;   // drop blobs larger than this, px (0: no limit)
     double aspect_min = 0.0;    // drop blobs whose box width/height is below this (0: off) ...
-    double aspect_max = 0.0;    // ... or above this (0: off); blobs touching the frame's edges are kept
+    double aspect_max = 0.0;    // ... or above this (0: off). A blob cut by the frame's left or right edge
+                                // (width a lower bound) meets only the upper limit, one cut at the top or
+                                // bottom (height a lower bound) only the lower, one cut both ways neither
     double min_fill = 0.0;      // drop blobs covering less than this share of their box (0: off)
     double size_gate = 0.0;     // drop an observation whose blob is more than size_gate times larger,
                                 // or (untouched by the frame's edges) smaller, than a landmark of the
