@@ -54,6 +54,10 @@ const char *kUsage =
     "  --gains G1,G2,...   count every training pixel as it would look at each of these exposure gains\n"
     "                      (the light or exposure changing; default 0.8,1,1.25)\n"
     "  --inset F           trim F of each box's size off every side before counting (default 0)\n"
+    "  --surround F        each class's surround: the background within F of a box's width/height\n"
+    "                      (at least 2 px) around its boxes (default 0.25; 0: none)\n"
+    "  --surround-weight W take out of a class the colours whose share in its boxes is at most W\n"
+    "                      times their share in its surround (default 0.5; 0: off)\n"
     "  --negatives PATH    extra background-only images (file, directory or .list; repeatable)\n"
     "  --all-boxes-ignored boxes of labels not learned are left out of the background (default:\n"
     "                      they are background: a yellow shirt teaches the ball class what not to be)\n"
@@ -489,6 +493,8 @@ int learn_main(int argc, char **argv)
             else if (s == "--smooth") lo.params.smooth_sigma_cells = parse_num(s, next(), 0, 2, false);
             else if (s == "--min-ratio") lo.params.min_likelihood_ratio = parse_num(s, next(), 0, 1e9, false);
             else if (s == "--inset") lo.inset = parse_num(s, next(), 0, 0.45, false);
+            else if (s == "--surround") lo.surround = parse_num(s, next(), 0, 10, false);
+            else if (s == "--surround-weight") lo.params.surround_weight = parse_num(s, next(), 0, 4, false);
             else if (s == "--negatives") negatives.push_back(next());
             else if (s == "--all-boxes-ignored") lo.other_boxes_negative = false;
             else if (s == "--no-weak") lo.weak = false;

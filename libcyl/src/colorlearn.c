@@ -72,6 +72,7 @@ cyl_learn_params cyl_learn_params_default(void)
     p.weak_bg_fraction = 0.03;
     p.min_weak_ratio = 1.5;
     p.min_class_share = 0.0;
+    p.surround_weight = 0.5;
     return p;
 }
 
@@ -213,7 +214,8 @@ cyl_status cyl_colortable_learn(cyl_colortable *t, const cyl_learn_class *classe
         !(p.min_positive_count >= 0.0 && p.min_positive_count < 1e30) ||
         !(p.weak_bg_fraction >= p.max_bg_fraction && p.weak_bg_fraction <= 1.0) ||
         !(p.min_weak_ratio >= 0.0 && p.min_weak_ratio <= p.min_likelihood_ratio) ||
-        !(p.min_class_share >= 0.0 && p.min_class_share <= 1.0))
+        !(p.min_class_share >= 0.0 && p.min_class_share <= 1.0) ||
+        !(p.surround_weight >= 0.0 && p.surround_weight <= 4.0))
         return CYL_ERR_ARG;
     for (i = 0; i < n; i++) {
         const cyl_learn_class *k = &classes[i];
@@ -260,6 +262,19 @@ cyl_status cyl_colortable_learn(cyl_colortable *t, const cyl_learn_class *classe
         float *L = lr[i];
         uint32_t kept = 0;
         smoothed(pos, L, p.smooth_sigma_cells);
+        if (classes[i].surround && classes[i].surround->total > 0 && p.surround_weight > 0.0) {
+            /* take out what the boxes share with their surround, scaled to the boxes' pixels;
+               the density stays per box pixel (npos), so the ratio floors keep their meaning */
+            const double scale = p.surround_weight * npos / (double)classes[i].surround->total;
+            double left = 0.0;
+            smoothed(classes[i].surround, tmp, p.smooth_sigma_cells);
+            for (c = 0; c < K; c++) {
+                double v = (double)L[c] - scale * (double)tmp[c];
+                L[c] = v > 0.0 ? (float)v : 0.0f;
+                left += (double)L[c];
+            }
+            if (!(left > 0.0)) return CYL_ERR_EMPTY;
+        }
         for (c = 0; c < K; c++) {
             double cnt = (double)L[c], v = 0.0;
             if (cnt >= p.min_positive_count && cnt > 0.0) {

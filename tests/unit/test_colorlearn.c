@@ -97,7 +97,7 @@ static void test_rate_decides_hand_derived(void **state)
 {
     cyl_colorhist *pos = hist_new(), *neg = hist_new();
     cyl_colortable *t = malloc(sizeof *t);
-    cyl_learn_class lc = { 2, CYL_CLASS_NONE, NULL };
+    cyl_learn_class lc = { 2, CYL_CLASS_NONE, NULL, NULL };
     size_t ws = cyl_learn_workspace_size(1);
     void *work = malloc(ws);
     cyl_learn_params p = exact_params();
@@ -162,12 +162,84 @@ static void test_rate_decides_hand_derived(void **state)
     free(pos); free(neg); free(t); free(work);
 }
 
+/* Background subtraction with the surround. Positives (the box): 600 px of the class's colour a,
+ * 400 px of the floor b. Surround: 2000 px of b, 1000 of the wall d. Negatives: 100 px of b,
+ * 9900 of e. Without the surround, b's ratio is (400/1000) / (100/10000) = 40: claimed.
+ * With weight 1 the surround, scaled to the box's 1000 px (x 1/3), takes 667 px off b (none
+ * left) and 0 off a: only a is the class. With weight 0.5 (x 1/6) b keeps 400 - 333.3 = 66.7
+ * px, still per the box's 1000: its ratio is 0.0667 / 0.01 = 6.67. */
+static void test_surround_subtracted_hand_derived(void **state)
+{
+    cyl_colorhist *pos = hist_new(), *neg = hist_new(), *sur = hist_new();
+    cyl_colortable *t = malloc(sizeof *t);
+    cyl_learn_class lc = { 1, CYL_CLASS_NONE, NULL, NULL };
+    size_t ws = cyl_learn_workspace_size(1);
+    void *work = malloc(ws);
+    cyl_learn_params p = exact_params();
+    cyl_learn_report r;
+    (void)state;
+    put(pos, 120, 200, 60, 600);   /* a */
+    put(pos, 140, 110, 150, 400);  /* b */
+    put(sur, 140, 110, 150, 2000); /* b */
+    put(sur, 160, 100, 100, 1000); /* d */
+    put(neg, 140, 110, 150, 100);  /* b */
+    put(neg, 60, 128, 128, 9900);  /* e */
+    lc.positive = pos;
+    cyl_colortable_init(t);
+    cyl_colortable_set_class(t, 1, "x", 1, 2, 3);
+    p.max_bg_fraction = 0.02;
+
+    p.surround_weight = 1.0;       /* no surround given: the weight does nothing */
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(r.cells, 2);
+    assert_int_equal(cyl_colortable_mask(t, 140, 110, 150), 1u << 1);
+    lc.surround = sur;
+    p.surround_weight = 0.0;       /* given, weight 0: the same */
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(r.cells, 2);
+
+    p.surround_weight = 1.0;
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(r.cells, 1);
+    assert_float_equal(r.recall, 0.6, 1e-12);     /* of the box's raw pixels */
+    assert_float_equal(r.bg_fraction, 0.0, 1e-12);
+    assert_int_equal(cyl_colortable_mask(t, 120, 200, 60), 1u << 1);
+    assert_int_equal(cyl_colortable_mask(t, 140, 110, 150), 0);
+    assert_int_equal(cyl_colortable_mask(t, 160, 100, 100), 0);
+
+    /* weight 0.5: b's ratio is 6.67, so a floor of 6.5 keeps it and one of 6.8 does not */
+    p.surround_weight = 0.5;
+    p.min_likelihood_ratio = 6.5;
+    p.min_weak_ratio = 6.5;
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(r.cells, 2);
+    assert_float_equal(r.bg_fraction, 0.01, 1e-12);
+    p.min_likelihood_ratio = 6.8;
+    p.min_weak_ratio = 6.8;
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_OK);
+    assert_int_equal(r.cells, 1);
+
+    /* a class whose every colour is as common around its boxes as in them is nothing */
+    p = exact_params();
+    p.max_bg_fraction = 0.02;
+    p.surround_weight = 1.0;
+    cyl_colorhist_clear(sur);
+    put(sur, 120, 200, 60, 600);
+    put(sur, 140, 110, 150, 400);
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_ERR_EMPTY);
+    p.surround_weight = 4.5;
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_ERR_ARG);
+    p.surround_weight = -0.1;
+    assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_ERR_ARG);
+    free(pos); free(neg); free(sur); free(t); free(work);
+}
+
 /* Two classes claim one cell: the one with the larger ratio keeps it, the report says so. */
 static void test_overlap_resolved_by_ratio(void **state)
 {
     cyl_colorhist *a = hist_new(), *b = hist_new(), *neg = hist_new();
     cyl_colortable *t = malloc(sizeof *t);
-    cyl_learn_class lc[2] = { { 0, CYL_CLASS_NONE, NULL }, { 5, CYL_CLASS_NONE, NULL } };
+    cyl_learn_class lc[2] = { { 0, CYL_CLASS_NONE, NULL, NULL }, { 5, CYL_CLASS_NONE, NULL, NULL } };
     size_t ws = cyl_learn_workspace_size(2);
     void *work = malloc(ws);
     cyl_learn_params p = exact_params();
@@ -217,7 +289,7 @@ static void test_brightness_dependent_chroma(void **state)
     size_t cap;
     cyl_colorhist *pos = hist_new(), *neg = hist_new();
     cyl_colortable *t = malloc(sizeof *t);
-    cyl_learn_class lc = { 0, CYL_CLASS_NONE, NULL };
+    cyl_learn_class lc = { 0, CYL_CLASS_NONE, NULL, NULL };
     unsigned i;
     size_t ws = cyl_learn_workspace_size(1);
     void *work = malloc(ws);
@@ -265,7 +337,7 @@ static void test_weak_class_hysteresis(void **state)
 {
     cyl_colorhist *pos = hist_new(), *neg = hist_new();
     cyl_colortable *t = malloc(sizeof *t);
-    cyl_learn_class lc = { 1, 4, NULL };
+    cyl_learn_class lc = { 1, 4, NULL, NULL };
     size_t ws = cyl_learn_workspace_size(1), ms;
     void *work = malloc(ws), *mem;
     cyl_learn_params p = exact_params();
@@ -356,6 +428,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hist_add),
         cmocka_unit_test(test_rate_decides_hand_derived),
+        cmocka_unit_test(test_surround_subtracted_hand_derived),
         cmocka_unit_test(test_overlap_resolved_by_ratio),
         cmocka_unit_test(test_brightness_dependent_chroma),
         cmocka_unit_test(test_weak_class_hysteresis),

@@ -60,6 +60,9 @@ struct ClassSpec {
 struct LearnOptions {
     cyl_learn_params params = cyl_learn_params_default();
     double inset = 0.0;                   // trim this fraction of a box's width/height off each side
+    double surround = 0.25;               // each class's surround: the background pixels within this fraction
+                                          // of a box's width/height (at least 2 px) around its boxes; 0 = none
+                                          // (params.surround_weight says how much of it is taken out)
     bool other_boxes_negative = true;     // boxes of labels not being learned count as background
     std::vector<std::string> negative_images;  // extra background images (every pixel negative)
     double flood_fraction = 0.03;         // warn when a class covers more than this of a training frame

@@ -223,6 +223,8 @@ LearnResult learn_core(cyl_colortable &t, size_t n_images, const std::function<L
     const size_t nc = classes.size();
     std::vector<std::unique_ptr<cyl_colorhist>> pos(nc);
     for (auto &p : pos) { p.reset(new cyl_colorhist); cyl_colorhist_clear(p.get()); }
+    std::vector<std::unique_ptr<cyl_colorhist>> sur(nc);
+    for (auto &p : sur) { p.reset(new cyl_colorhist); cyl_colorhist_clear(p.get()); }
     std::unique_ptr<cyl_colorhist> neg(new cyl_colorhist);
     cyl_colorhist_clear(neg.get());
     LearnResult res;
@@ -281,6 +283,22 @@ LearnResult learn_core(cyl_colortable &t, size_t n_images, const std::function<L
                 check(cyl_colorhist_add_scaled(pos[i].get(), &l.frame.img, nullptr, m.data(), (size_t)w, 1, g),
                       path + ": class histogram");
             res.classes[i].positive_px += (pos[i]->total - before) / o.gains.size();
+            if (o.surround > 0) {
+                // the ring: background pixels (mask 0) within the grown boxes of the class
+                std::fill(m.begin(), m.end(), 0);
+                for (const Box &b : l.boxes)
+                    if (b.label == classes[i].label) {
+                        Box g = b;
+                        const double dx = std::max(2.0, o.surround * b.width()), dy = std::max(2.0, o.surround * b.height());
+                        g.x0 -= dx; g.x1 += dx; g.y0 -= dy; g.y1 += dy;
+                        paint(m, w, h, g, 0.0, 1);
+                    }
+                for (size_t k = 0; k < m.size(); k++)
+                    if (mask[k] != 0) m[k] = 0;
+                for (double g : o.gains)
+                    check(cyl_colorhist_add_scaled(sur[i].get(), &l.frame.img, nullptr, m.data(), (size_t)w, 1, g),
+                          path + ": surround histogram");
+            }
         }
         for (double g : o.gains)
             check(cyl_colorhist_add_scaled(neg.get(), &l.frame.img, nullptr, mask.data(), (size_t)w, 0, g),
@@ -311,6 +329,7 @@ LearnResult learn_core(cyl_colortable &t, size_t n_images, const std::function<L
     for (size_t i = 0; i < nc; i++) {
         lc[i].cls = idx[i];
         lc[i].positive = pos[i].get();
+        lc[i].surround = o.surround > 0 ? sur[i].get() : nullptr;
         lc[i].weak_cls = CYL_CLASS_NONE;
         if (!o.weak) continue;
         std::string wn = classes[i].name.substr(0, CYL_CLASS_NAME_LEN - 2) + "~";

@@ -11,6 +11,11 @@
  *     default every pixel outside all labelled boxes) in histograms over the
  *     3-D table's quantised YUV cells (cyl_colorhist, 32 x 64 x 64 cells), in
  *     which chroma may depend on brightness.
+ *     A box holds background too (a cone fills half of its box; the edge of a
+ *     stripe mixes with the surface it is painted on). Optionally each class
+ *     also counts its boxes' surround (a ring of pixels just outside them):
+ *     the colours as common around a box as in it are taken out of the
+ *     class's density before the ratio (surround_weight).
  *  2. Smooth both with a Gaussian of smooth_sigma_cells cells per axis, so
  *     that colours next to the seen ones (slightly brighter, slightly more
  *     saturated) are covered too, and mix into the background density a
@@ -98,6 +103,11 @@ typedef struct cyl_learn_params {
     double min_class_share;      /* the class keeps at least this share of its own training pixels,
                                     the threshold lowered below the rate's if need be (never under
                                     min_likelihood_ratio); 0..1 (default 0: the rate alone) */
+    double surround_weight;      /* background subtraction for classes given a surround histogram:
+                                    after smoothing, a cell's class count becomes
+                                    max(0, n_box - w * (N_box / N_surround) * n_surround), still divided
+                                    by N_box: a colour whose share in the boxes is at most w times its
+                                    share around them is not the class's; 0 = off, 0..4 (default 0.5) */
 } cyl_learn_params;
 
 /* The defaults above: chosen on training data only (docs/colour-learning.md, "How the
@@ -127,6 +137,8 @@ typedef struct cyl_learn_class {
     unsigned cls;                    /* its table index */
     unsigned weak_cls;               /* table index for its weak evidence, or CYL_CLASS_NONE */
     const cyl_colorhist *positive;   /* its training pixels */
+    const cyl_colorhist *surround;   /* pixels just around its boxes (outside every box), or NULL:
+                                        what the boxes' background looks like (surround_weight) */
 } cyl_learn_class;
 
 /* Bytes of workspace cyl_colortable_learn() needs for n classes. */
