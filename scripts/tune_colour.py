@@ -82,8 +82,8 @@ def main():
     ap.add_argument("--build", default="build")
     ap.add_argument("--quick", action="store_true", help="a small grid")
     ap.add_argument("--grid", action="append", default=[], metavar="KEY=V1,V2,...",
-                    help="replace one learning grid axis (fpr, smooth, weak_fpr, min_weak_ratio, gains as "
-                         "G1/G2/..., surround, surround_weight), e.g. --grid surround_weight=0,1")
+                    help="replace one learning grid axis (fpr, smooth, weak_fpr, min_weak_ratio, gains and "
+                         "colour_temps as V1/V2/..., surround, surround_weight), e.g. --grid surround_weight=0,1")
     a = ap.parse_args()
     sets = realeval.splits(a.shared)
     ball_train = sets["ball"]["train"]
@@ -94,14 +94,15 @@ def main():
         "weak_fpr": [0.01] if a.quick else [0.01, 0.03],
         "min_weak_ratio": [1.5] if a.quick else [1.5, 3.0],
         "gains": ["1"] if a.quick else ["1", "0.8,1,1.25"],
-        "surround": [0.5],
-        "surround_weight": [1.0] if a.quick else [0.0, 1.0],
+        "colour_temps": ["0"],
+        "surround": [0.25],
+        "surround_weight": [0.5],
     }
     for g in a.grid:
         key, _, vals = g.partition("=")
         if key not in learn_grid or not vals:
             ap.error(f"--grid {g}: KEY=V1,V2,... with KEY one of {', '.join(learn_grid)}")
-        learn_grid[key] = [v.replace("/", ",") for v in vals.split(",")] if key == "gains" else \
+        learn_grid[key] = [v.replace("/", ",") for v in vals.split(",")] if key in ("gains", "colour_temps") else \
             [float(v) for v in vals.split(",")]
     gate_grid = {
         "aspect_margin": [1.5],  # 1.25 and 2 did no better on the first grid
@@ -115,9 +116,9 @@ def main():
         run([os.path.join(a.build, "cyl-render"), "-S", "hard", "-n", "40", "-s", "5", "-q",
              "-o", os.path.join(hard_dir, "drive.cylraw"), "--labels", hard_dir])
         hard_imgs = sorted(os.path.join(hard_dir, "images", f) for f in os.listdir(os.path.join(hard_dir, "images")))
-        for fpr, smooth, wfpr, wratio, gains, sur, surw in itertools.product(*learn_grid.values()):
+        for fpr, smooth, wfpr, wratio, gains, temps, sur, surw in itertools.product(*learn_grid.values()):
             la = ["--fpr", str(fpr), "--smooth", str(smooth), "--weak-fpr", str(wfpr), "--min-weak-ratio", str(wratio),
-                  "--gains", gains, "--surround", str(sur), "--surround-weight", str(surw)]
+                  "--gains", gains, "--colour-temps", temps, "--surround", str(sur), "--surround-weight", str(surw)]
             learned = {}
             learned["hard"] = learn(a.build, tmp, "hard", hard_imgs[:1], [("orange", 0), ("green", 1)], la)
             for y in years:
@@ -150,7 +151,7 @@ def main():
                 objective = min(rec.values()) - max(0.0, fp - 0.8) - max(0.0, hard_fp - 0.2)
                 mean_recall = sum(rec.values()) / len(rec)   # breaks ties of the objective
                 row = {"fpr": fpr, "smooth": smooth, "weak_fpr": wfpr, "min_weak_ratio": wratio, "gains": gains,
-                       "surround": sur, "surround_weight": surw,
+                       "colour_temps": temps, "surround": sur, "surround_weight": surw,
                        "aspect_margin": margin, "min_fill": fill, "hard_fp": round(hard_fp, 2),
                        "merge_gap": gap, **{k: round(v, 3) for k, v in rec.items()}, "fp_max": round(fp, 2),
                        "objective": round(objective, 3), "mean_recall": round(mean_recall, 3)}

@@ -53,6 +53,8 @@ const char *kUsage =
     "  --no-weak           no weak class\n"
     "  --gains G1,G2,...   count every training pixel as it would look at each of these exposure gains\n"
     "                      (the light or exposure changing; default 0.8,1,1.25)\n"
+    "  --colour-temps T1,T2,...  ... and at each of these light colours: red gain 1+T, blue gain\n"
+    "                      1/(1+T) (T > 0 warmer, < 0 cooler; -0.45..1; default 0: as taken)\n"
     "  --inset F           trim F of each box's size off every side before counting (default 0)\n"
     "  --surround F        each class's surround: the background within F of a box's width/height\n"
     "                      (at least 2 px) around its boxes (default 0.25; 0: none)\n"
@@ -498,14 +500,16 @@ int learn_main(int argc, char **argv)
             else if (s == "--negatives") negatives.push_back(next());
             else if (s == "--all-boxes-ignored") lo.other_boxes_negative = false;
             else if (s == "--no-weak") lo.weak = false;
-            else if (s == "--gains") {
+            else if (s == "--gains" || s == "--colour-temps") {
+                const bool gains = s == "--gains";
+                std::vector<double> &list = gains ? lo.gains : lo.colour_temperatures;
                 std::string v = next();
-                lo.gains.clear();
+                list.clear();
                 size_t pos = 0;
                 while (pos <= v.size()) {
                     size_t c = v.find(',', pos);
-                    lo.gains.push_back(parse_num("--gains", v.substr(pos, c == std::string::npos ? std::string::npos : c - pos),
-                                                 0.1, 10, false));
+                    list.push_back(parse_num(s, v.substr(pos, c == std::string::npos ? std::string::npos : c - pos),
+                                             gains ? 0.1 : -0.45, gains ? 10 : 1, false));
                     if (c == std::string::npos) break;
                     pos = c + 1;
                 }

@@ -23,21 +23,66 @@ static uint8_t scale_level(uint8_t v, double centre, double gain)
     return (uint8_t)floor(x + 0.5);
 }
 
+static double clip_channel(double x)
+{
+    return x < 0.0 ? 0.0 : (x > 255.0 ? 255.0 : x);
+}
+
+static uint8_t clip_level(double x)
+{
+    if (!(x > 0.0)) return 0;
+    if (x > 255.0) return 255;
+    return (uint8_t)floor(x + 0.5);
+}
+
+/* A colour as it would be under the channel gains g (red, green, blue). Equal gains scale Y and
+ * the chroma offsets (exposure); otherwise through R, G, B (BT.601 full range), each channel
+ * clipped as a sensor would. */
+static void map_colour(uint8_t *Y, uint8_t *U, uint8_t *V, const double g[3])
+{
+    if (g[0] == g[1] && g[1] == g[2]) {
+        if (g[0] == 1.0) return;
+        *Y = scale_level(*Y, 0.0, g[0]);
+        *U = scale_level(*U, 128.0, g[0]);
+        *V = scale_level(*V, 128.0, g[0]);
+    } else {
+        const double u = (double)*U - 128.0, v = (double)*V - 128.0;
+        const double R = clip_channel(g[0] * ((double)*Y + 1.402 * v));
+        const double G = clip_channel(g[1] * ((double)*Y - 0.344136 * u - 0.714136 * v));
+        const double B = clip_channel(g[2] * ((double)*Y + 1.772 * u));
+        const double Yo = 0.299 * R + 0.587 * G + 0.114 * B;
+        *Y = clip_level(Yo);
+        *U = clip_level(128.0 + (B - Yo) / 1.772);
+        *V = clip_level(128.0 + (R - Yo) / 1.402);
+    }
+}
+
 cyl_status cyl_colorhist_add(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
                              const uint8_t *mask, size_t mask_stride, uint8_t mask_value)
 {
-    return cyl_colorhist_add_scaled(h, img, roi, mask, mask_stride, mask_value, 1.0);
+    const double one[3] = { 1.0, 1.0, 1.0 };
+    return cyl_colorhist_add_rgb_gains(h, img, roi, mask, mask_stride, mask_value, one);
 }
 
 cyl_status cyl_colorhist_add_scaled(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
                                     const uint8_t *mask, size_t mask_stride, uint8_t mask_value,
                                     double gain)
 {
+    const double g[3] = { gain, gain, gain };
+    return cyl_colorhist_add_rgb_gains(h, img, roi, mask, mask_stride, mask_value, g);
+}
+
+cyl_status cyl_colorhist_add_rgb_gains(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
+                                       const uint8_t *mask, size_t mask_stride, uint8_t mask_value,
+                                       const double gain_rgb[3])
+{
     cyl_roi r;
     uint32_t x, y;
     cyl_status s;
-    const int scaled = gain != 1.0;
-    if (!h || !(gain > 0.0 && gain <= 16.0)) return CYL_ERR_ARG;
+    unsigned k;
+    if (!h || !gain_rgb) return CYL_ERR_ARG;
+    for (k = 0; k < 3; k++)
+        if (!(gain_rgb[k] > 0.0 && gain_rgb[k] <= 16.0)) return CYL_ERR_ARG;
     s = cyl_image_check(img);
     if (s != CYL_OK) return s;
     if (mask && mask_stride < img->width) return CYL_ERR_SIZE;
@@ -49,11 +94,7 @@ cyl_status cyl_colorhist_add_scaled(cyl_colorhist *h, const cyl_image *img, cons
             uint32_t *c;
             if (m && m[x] != mask_value) continue;
             cyl_pixel_fetch(img, x, y, &Y, &U, &V);
-            if (scaled) {
-                Y = scale_level(Y, 0.0, gain);
-                U = scale_level(U, 128.0, gain);
-                V = scale_level(V, 128.0, gain);
-            }
+            map_colour(&Y, &U, &V, gain_rgb);
             c = &h->count[cyl_yuv_cell(Y, U, V)];
             if (*c != UINT32_MAX) { (*c)++; h->total++; }
         }

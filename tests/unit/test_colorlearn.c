@@ -91,6 +91,44 @@ static void test_hist_add(void **state)
     free(buf); free(h);
 }
 
+/* Colour-temperature augmentation, by hand (BT.601 full range). Grey (100, 128, 128) under red gain
+ * 1.2 and blue gain 1/1.2: R, G, B = 120, 100, 83.33; Y = 0.299 R + 0.587 G + 0.114 B = 104.08,
+ * U = 128 + (B - Y) / 1.772 = 116.29, V = 128 + (R - Y) / 1.402 = 139.36 -> (104, 116, 139).
+ * Near white (250, 128, 128): R = 300 clips to 255, B = 208.33; Y = 246.75, U = 106.32,
+ * V = 133.89 -> (247, 106, 134). Equal gains are the exposure scaling. */
+static void test_hist_rgb_gains(void **state)
+{
+    canvas c;
+    cyl_image img;
+    uint8_t *buf;
+    size_t cap;
+    cyl_colorhist *h = hist_new(), *h2 = hist_new();
+    const double warm[3] = { 1.2, 1.0, 1.0 / 1.2 }, equal[3] = { 1.25, 1.25, 1.25 };
+    double bad[3] = { 1.0, 0.0, 1.0 };
+    unsigned k;
+    (void)state;
+    assert_true(canvas_alloc(&c, 8, 6));
+    canvas_fill(&c, 100, 128, 128);
+    canvas_rect(&c, 0, 0, 4, 6, 250, 128, 128);
+    cap = canvas_format_size(&c, CYL_FMT_YUV444P, 0);
+    buf = malloc(cap);
+    assert_true(canvas_to_format(&c, CYL_FMT_YUV444P, 0, 0, buf, cap, &img));
+    assert_int_equal(cyl_colorhist_add_rgb_gains(h, &img, NULL, NULL, 0, 0, warm), CYL_OK);
+    assert_int_equal(h->total, 48);
+    assert_int_equal(h->count[cyl_yuv_cell(104, 116, 139)], 24);
+    assert_int_equal(h->count[cyl_yuv_cell(247, 106, 134)], 24);
+    cyl_colorhist_clear(h);
+    assert_int_equal(cyl_colorhist_add_rgb_gains(h, &img, NULL, NULL, 0, 0, equal), CYL_OK);
+    assert_int_equal(cyl_colorhist_add_scaled(h2, &img, NULL, NULL, 0, 0, 1.25), CYL_OK);
+    for (k = 0; k < CYL_YUV_CELLS; k++) assert_int_equal(h->count[k], h2->count[k]);
+    assert_int_equal(cyl_colorhist_add_rgb_gains(h, &img, NULL, NULL, 0, 0, bad), CYL_ERR_ARG);
+    bad[1] = 17.0;
+    assert_int_equal(cyl_colorhist_add_rgb_gains(h, &img, NULL, NULL, 0, 0, bad), CYL_ERR_ARG);
+    assert_int_equal(cyl_colorhist_add_rgb_gains(h, &img, NULL, NULL, 0, 0, NULL), CYL_ERR_ARG);
+    canvas_free(&c);
+    free(buf); free(h); free(h2);
+}
+
 /* Positives: 900 px at colour a, 100 at colour c. Negatives: 10 px at c, 9990 at b.
  * Ratios: a infinite (no background), c = 0.1 / 0.001 = 100, b = 0. */
 static void test_rate_decides_hand_derived(void **state)
@@ -427,6 +465,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hist_add),
+        cmocka_unit_test(test_hist_rgb_gains),
         cmocka_unit_test(test_rate_decides_hand_derived),
         cmocka_unit_test(test_surround_subtracted_hand_derived),
         cmocka_unit_test(test_overlap_resolved_by_ratio),

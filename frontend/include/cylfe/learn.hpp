@@ -70,6 +70,8 @@ struct LearnOptions {
     bool weak_from_top = false;           // place weak classes at the highest free indices (else lowest)
     std::vector<double> gains{0.8, 1.0, 1.25};  // every training pixel counted at each of these exposure gains
                                           // (cyl_colorhist_add_scaled: photometric augmentation)
+    std::vector<double> colour_temperatures{0.0};  // ... and at each of these light colours: t gives red gain
+                                          // 1 + t, blue gain 1 / (1 + t) (warmer for t > 0; -0.5 < t <= 1)
 };
 
 struct ClassReport {

@@ -207,6 +207,18 @@ void paint(std::vector<uint8_t> &mask, int w, int h, const Box &b, double inset,
     for (int y = y0; y < y1; y++) std::memset(&mask[(size_t)y * w + x0], value, (size_t)std::max(0, x1 - x0));
 }
 
+// Count the pixels of img whose mask byte equals value (mask null: all) into h, once per
+// exposure gain and colour temperature of the options (photometric augmentation).
+void count_augmented(cyl_colorhist *h, const cyl_image &img, const uint8_t *mask, size_t stride, uint8_t value,
+                     const LearnOptions &o, const std::string &what)
+{
+    for (double g : o.gains)
+        for (double t : o.colour_temperatures) {
+            const double rgb[3] = {g * (1.0 + t), g, g / (1.0 + t)};
+            check(cyl_colorhist_add_rgb_gains(h, &img, nullptr, mask, stride, value, rgb), what);
+        }
+}
+
 } // namespace
 
 namespace {
@@ -220,6 +232,10 @@ LearnResult learn_core(cyl_colortable &t, size_t n_images, const std::function<L
     if (classes.size() > CYL_MAX_CLASSES) throw Error("at most 8 classes");
     if (n_images == 0) throw Error("no training images");
     if (o.gains.empty()) throw Error("no exposure gain to learn at");
+    if (o.colour_temperatures.empty()) throw Error("no colour temperature to learn at");
+    for (double t : o.colour_temperatures)
+        if (!(t > -0.5 && t <= 1.0)) throw Error("colour temperature shift " + num(t) + " outside (-0.5, 1]");
+    const uint64_t passes = (uint64_t)(o.gains.size() * o.colour_temperatures.size());
     const size_t nc = classes.size();
     std::vector<std::unique_ptr<cyl_colorhist>> pos(nc);
     for (auto &p : pos) { p.reset(new cyl_colorhist); cyl_colorhist_clear(p.get()); }
@@ -279,10 +295,8 @@ LearnResult learn_core(cyl_colortable &t, size_t n_images, const std::function<L
                     }
                 }
             const uint64_t before = pos[i]->total;
-            for (double g : o.gains)
-                check(cyl_colorhist_add_scaled(pos[i].get(), &l.frame.img, nullptr, m.data(), (size_t)w, 1, g),
-                      path + ": class histogram");
-            res.classes[i].positive_px += (pos[i]->total - before) / o.gains.size();
+            count_augmented(pos[i].get(), l.frame.img, m.data(), (size_t)w, 1, o, path + ": class histogram");
+            res.classes[i].positive_px += (pos[i]->total - before) / passes;
             if (o.surround > 0) {
                 // the ring: background pixels (mask 0) within the grown boxes of the class
                 std::fill(m.begin(), m.end(), 0);
@@ -295,27 +309,22 @@ LearnResult learn_core(cyl_colortable &t, size_t n_images, const std::function<L
                     }
                 for (size_t k = 0; k < m.size(); k++)
                     if (mask[k] != 0) m[k] = 0;
-                for (double g : o.gains)
-                    check(cyl_colorhist_add_scaled(sur[i].get(), &l.frame.img, nullptr, m.data(), (size_t)w, 1, g),
-                          path + ": surround histogram");
+                count_augmented(sur[i].get(), l.frame.img, m.data(), (size_t)w, 1, o, path + ": surround histogram");
             }
         }
-        for (double g : o.gains)
-            check(cyl_colorhist_add_scaled(neg.get(), &l.frame.img, nullptr, mask.data(), (size_t)w, 0, g),
-                  path + ": background histogram");
+        count_augmented(neg.get(), l.frame.img, mask.data(), (size_t)w, 0, o, path + ": background histogram");
         if (progress) progress(++done, total);
     }
     for (const std::string &path : o.negative_images) {
         calib::Frame f = calib::load_frame(path);
-        for (double g : o.gains)
-            check(cyl_colorhist_add_scaled(neg.get(), &f.img, nullptr, nullptr, 0, 0, g), path + ": background histogram");
+        count_augmented(neg.get(), f.img, nullptr, 0, 0, o, path + ": background histogram");
         if (progress) progress(++done, total);
     }
     for (size_t i = 0; i < nc; i++)
         if (pos[i]->total == 0)
             throw Error("class '" + classes[i].name + "' (label " + std::to_string(classes[i].label) +
                         "): no labelled pixel in the " + std::to_string(n_images) + " training images");
-    res.negative_px = neg->total / o.gains.size();
+    res.negative_px = neg->total / passes;
     res.images = n_images;
 
     static const uint8_t pal[CYL_MAX_CLASSES][3] = {{255, 120, 0}, {0, 200, 60}, {0, 90, 255}, {255, 220, 0},

@@ -75,6 +75,16 @@ cyl_status cyl_colorhist_add_scaled(cyl_colorhist *h, const cyl_image *img, cons
                                     const uint8_t *mask, size_t mask_stride, uint8_t mask_value,
                                     double gain);
 
+/* Like cyl_colorhist_add_scaled(), with each pixel's colour as it would be under light of another
+ * colour and brightness: the colour converted to R, G, B (BT.601, full range: R = Y + 1.402 (V - 128),
+ * G = Y - 0.344 (U - 128) - 0.714 (V - 128), B = Y + 1.772 (U - 128)), each channel multiplied by its
+ * gain (gain_rgb[0] red, [1] green, [2] blue; > 0 and <= 16), converted back, rounded and clipped to
+ * 0..255. Equal gains g are cyl_colorhist_add_scaled() with gain g; red and blue gains apart model a
+ * change of white balance or of the light's colour temperature (warmer: red up, blue down). */
+cyl_status cyl_colorhist_add_rgb_gains(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
+                                       const uint8_t *mask, size_t mask_stride, uint8_t mask_value,
+                                       const double gain_rgb[3]);
+
 /* Empty histogram. */
 void cyl_colorhist_clear(cyl_colorhist *h);
 
