@@ -9,9 +9,10 @@ One recipe for every set (cyl-train learn and cyl-score with their defaults, no 
     images of valid/ (every 12th from the 6th, in name order), test on all of test/.
   * the hard rendered scene (cyl-render --scene hard: floor and wall in hues near the landmarks',
     coloured clutter, an illumination gradient, cast shadows, exposure and white-balance drift):
-    learn on frame 0 (its truth boxes), test on the other frames; recall and false blobs against
-    the truth boxes, and the bearing error of cyl detect's observations against the true
-    landmarks.
+    learn on frame 0 (its truth boxes, and the landmarks' size for the expected-size gate), test on
+    the other frames; recall and false blobs of the detector's observations (cyl-score with the
+    scene's camera; also without it) against the truth boxes, and the bearing error of cyl
+    detect's observations against the true landmarks.
 Prints each set's training report and scores, then one JSON line with the figures.
 
 Usage: scripts/realeval.py [--shared DIR] [--build DIR] [--out DIR] [--subset DIR]
@@ -71,7 +72,7 @@ def run(cmd):
     return p.stdout
 
 
-def learn_and_score(build, out, name, train, test, classes):
+def learn_and_score(build, out, name, train, test, classes, learn_extra=(), calib=None):
     table = os.path.join(out, name + ".cylt")
     config = os.path.join(out, name + "-detector.yaml")
     report = os.path.join(out, name + "-training.json")
@@ -84,7 +85,7 @@ def learn_and_score(build, out, name, train, test, classes):
     for c, label in classes:
         cls += ["--class", f"{c}={label}"]
     text = run([os.path.join(build, "cyl-train"), "learn", "-q", "-o", table, "--report", report, "--config-out", config]
-               + cls + [tl])
+               + cls + list(learn_extra) + [tl])
     with open(report) as f:
         rep = json.load(f)
     print(f"== {name}: learned on {len(train)} images, tested on {len(test)}")
@@ -95,7 +96,7 @@ def learn_and_score(build, out, name, train, test, classes):
             print(f"   warning: {w}")
     del text
     score = run([os.path.join(build, "cyl-score"), "-q", "--table", table, "--config", config,
-                 "--boxes", os.path.join(out, name + "-boxes.csv")] + cls + [sl])
+                 "--boxes", os.path.join(out, name + "-boxes.csv")] + (["--calib", calib] if calib else []) + cls + [sl])
     print("   " + "\n   ".join(score.strip().splitlines()[:-1]))
     return json.loads(score.strip().splitlines()[-1])
 
@@ -142,9 +143,17 @@ def hard_synth(build, out, frames, seed=3):
          "--labels", d])
     imgs = sorted(os.path.join(d, "images", f) for f in os.listdir(os.path.join(d, "images")))
     classes = [("orange", 0), ("green", 1)]
-    sc = learn_and_score(build, out, "hard", imgs[:1], imgs[1:], classes)
     cam = os.path.join(d, "camera.yaml")
     run([os.path.join(build, "cyl-render"), "-S", "hard", "--write-camera", cam])
+    # the landmarks' size goes into the detector config (the expected-size gate at the measured
+    # range), and the scene's camera lets cyl-score score the detector's observations
+    sc = learn_and_score(build, out, "hard", imgs[:1], imgs[1:], classes,
+                         ["--size", "orange=0.10,0.30", "--size", "green=0.10,0.30"], cam)
+    # the same without the camera: the blobs the camera-free gates keep, as on the real sets
+    nc = run([os.path.join(build, "cyl-score"), "-q", "--table", os.path.join(out, "hard.cylt"), "--config",
+              os.path.join(out, "hard-detector.yaml"), "--class", "orange=0", "--class", "green=1",
+              os.path.join(out, "hard-test.list")])
+    nc = json.loads(nc.strip().splitlines()[-1])["classes"]
     log = os.path.join(d, "obs.jsonl")
     run([os.path.join(build, "cyl"), "detect", raw, "--table", os.path.join(out, "hard.cylt"), "--calib", cam,
          "--config", os.path.join(out, "hard-detector.yaml"), "--size", "orange=0.10,0.30", "--size", "green=0.10,0.30",
@@ -157,10 +166,15 @@ def hard_synth(build, out, frames, seed=3):
         "hard_synth_recall": (o["recall_iou50"] * o["boxes"] + g["recall_iou50"] * g["boxes"]) / max(boxes, 1),
         "hard_synth_recall_centroid": (o["recall_centroid"] * o["boxes"] + g["recall_centroid"] * g["boxes"]) / max(boxes, 1),
         "hard_synth_fp_per_frame": o["fp_per_image"] + g["fp_per_image"],
+        "hard_synth_recall_no_camera": (nc["orange"]["recall_iou50"] * o["boxes"] + nc["green"]["recall_iou50"] * g["boxes"])
+        / max(boxes, 1),
+        "hard_synth_fp_per_frame_no_camera": nc["orange"]["fp_per_image"] + nc["green"]["fp_per_image"],
         "hard_synth_bearing_err_median_deg": math.degrees(errs[len(errs) // 2]) if errs else None,
         "hard_synth_bearing_err_p95_deg": math.degrees(errs[int(0.95 * (len(errs) - 1))]) if errs else None,
         "hard_synth_observations_matched": len(errs),
     }
+    print(f"   without the camera (no size gate): recall {res['hard_synth_recall_no_camera']:.3f}, "
+          f"false blobs per frame {res['hard_synth_fp_per_frame_no_camera']:.2f}")
     print(f"   bearing error of {len(errs)} matched observations: median {res['hard_synth_bearing_err_median_deg']} deg, "
           f"95% {res['hard_synth_bearing_err_p95_deg']} deg")
     return res

@@ -358,9 +358,11 @@ int cmd_detect(const Args &a)
         cfg.observe.size[cls] = {d, h};
     }
     // A class without a size gets confidence 0 on every observation, and a SLAM back end that
-    // filters on confidence then uses none of them: say so.
+    // filters on confidence then uses none of them: say so. (A weak class, NAME~, makes no blobs of
+    // its own: its pixels join its class's.)
     for (unsigned k = 0; k < CYL_MAX_CLASSES; k++)
-        if (table.name[k][0] && !(cfg.observe.size[k].diameter_m > 0 && cfg.observe.size[k].height_m > 0))
+        if (table.name[k][0] && table.weak_of[k] == CYL_CLASS_NONE &&
+            !(cfg.observe.size[k].diameter_m > 0 && cfg.observe.size[k].height_m > 0))
             std::fprintf(stderr, "cyl: warning: class '%s' has no landmark size (--size %s=D,H): its observations get "
                                  "confidence 0\n", table.name[k], table.name[k]);
 

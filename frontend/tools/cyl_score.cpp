@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cylfe/calib.hpp"
+#include "cylfe/calibration.hpp"
 #include "cylfe/error.hpp"
 #include "cylfe/learn.hpp"
 #include "cylfe/progress.hpp"
@@ -34,6 +35,9 @@ const char *kUsage =
     "  --class NAME=LABEL  table class NAME against label id LABEL (repeatable, required)\n"
     "  --config FILE.yaml  detector config (cyl detect's; cyl-train learn --config-out writes one): the\n"
     "                      segmentation and the gates that need no camera (area, aspect, fill, mask)\n"
+    "  --calib FILE.yaml   camera calibration (cyl detect's --calib; frames of its size): score the\n"
+    "                      blobs of the detector's observations instead, after every gate including\n"
+    "                      the expected-size gate at the measured range (size_m, size_gate in --config)\n"
     "  --min-area N        drop blobs smaller than N px (default: the segmentation default, 9)\n"
     "  --merge-gap N       merge blobs of a class whose boxes are <= N px apart (default 3; -1 off)\n"
     "  --max-area N        drop blobs larger than N px (default: no limit)\n"
@@ -72,7 +76,7 @@ int main(int argc, char **argv)
     learn::ScoreOptions so;
     bool quiet = false;
     long min_area = -1, merge_gap = -2, max_area = -1;
-    std::string config;
+    std::string config, calib_path;
     try {
         if (argc < 2) throw Usage("no arguments");
         for (int i = 1; i < argc; i++) {
@@ -87,6 +91,7 @@ int main(int argc, char **argv)
             else if (s == "--merge-gap") merge_gap = (long)number(s, next(), -1, 1000, true);
             else if (s == "--max-area") max_area = (long)number(s, next(), 0, 1e9, true);
             else if (s == "--config") config = next();
+            else if (s == "--calib") calib_path = next();
             else if (s == "--iou") so.iou = number(s, next(), 0.01, 1, false);
             else if (s == "--fp-min-area") so.fp_min_area = (uint32_t)number(s, next(), 0, 1e9, true);
             else if (s == "--overlay") so.overlay_dir = next();
@@ -118,6 +123,11 @@ int main(int argc, char **argv)
             if (min_area >= 0) so.detector.segment.cls[k].min_area = (uint32_t)min_area;
             if (merge_gap >= -1) so.detector.segment.cls[k].merge_gap_px = (int32_t)merge_gap;
             if (max_area >= 0) so.detector.gate[k].max_area_px = (uint32_t)max_area;
+        }
+        cyl_camera cam{};
+        if (!calib_path.empty()) {
+            cam = load_camera_calibration(calib_path).cam;
+            so.camera = &cam;
         }
         std::vector<std::string> images = learn::expand_images(inputs);
         Progress bar(!quiet, "scoring", "images");

@@ -40,7 +40,7 @@ const char *kUsage =
     "  --class NAME=LABEL[@INDEX]  learn class NAME from the boxes with label id LABEL (repeatable;\n"
     "                      INDEX: its table index, lower wins where box classes overlap)\n"
     "  --fpr F             share of background pixels a class may claim (default 0.001)\n"
-    "  --smooth S          smoothing of the colour histograms, cells (default 2)\n"
+    "  --smooth S          smoothing of the colour histograms, cells (default 1.5)\n"
     "  --min-ratio R       never claim a colour less than R times likelier in the class (default 4)\n"
     "  --weak-fpr F        share of background the class and its weak class NAME~ may claim together\n"
     "                      (default 0.03); weak pixels count only where they touch the class's own\n"
@@ -69,6 +69,9 @@ const char *kUsage =
     "                      width/height range widened by --aspect-margin (default 1.5) each way,\n"
     "                      min_fill (default 0.3) and merge_gap_px (default 3)\n"
     "  --aspect-margin M, --min-fill F, --merge-gap N   (for --config-out)\n"
+    "  --size NAME=D,H     (for --config-out, repeatable) the class's landmark diameter and height,\n"
+    "                      m: the config gets size_m and the expected-size gate at the measured range\n"
+    "  --size-gate F       that gate's factor for classes given a size (default 2; 0: off)\n"
     "  --base IN.cylt      start from this table; -q quiet; -o required\n"
     "\n"
     "rectangles (the paper's method, cyl_colortable_train: a UV histogram of the region, thresholded,\n"
@@ -469,7 +472,8 @@ int run_gui(Opts &o, cyl_colortable &t, const cyl_train_params &params)
 int learn_main(int argc, char **argv)
 {
     std::string out, base, report, config_out;
-    double aspect_margin = 1.5, min_fill = 0.3;
+    double aspect_margin = 1.5, min_fill = 0.3, size_gate = 2.0;
+    std::vector<std::pair<std::string, std::pair<double, double>>> sizes;
     long merge_gap = 3;
     std::vector<learn::ClassSpec> classes;
     std::vector<std::string> inputs, negatives;
@@ -489,6 +493,18 @@ int learn_main(int argc, char **argv)
             else if (s == "--config-out") config_out = next();
             else if (s == "--aspect-margin") aspect_margin = parse_num(s, next(), 1, 100, false);
             else if (s == "--min-fill") min_fill = parse_num(s, next(), 0, 1, false);
+            else if (s == "--size-gate") {
+                size_gate = parse_num(s, next(), 0, 100, false);
+                if (size_gate > 0 && size_gate < 1) throw Usage("--size-gate: 0 (off) or >= 1");
+            }
+            else if (s == "--size") {
+                std::string v = next();
+                size_t eq = v.find('='), comma = v.find(',', eq == std::string::npos ? 0 : eq);
+                if (eq == std::string::npos || eq == 0 || comma == std::string::npos)
+                    throw Usage("--size: expected NAME=D,H, got '" + v + "'");
+                sizes.push_back({v.substr(0, eq), {parse_num(s, v.substr(eq + 1, comma - eq - 1), 1e-6, 1e3, false),
+                                                   parse_num(s, v.substr(comma + 1), 1e-6, 1e3, false)}});
+            }
             else if (s == "--merge-gap") merge_gap = (long)parse_num(s, next(), -1, 1000, true);
             else if (s == "-q" || s == "--quiet") quiet = true;
             else if (s == "--fpr") lo.params.max_bg_fraction = parse_num(s, next(), 0, 1, false);
@@ -538,6 +554,7 @@ int learn_main(int argc, char **argv)
             else inputs.push_back(s);
         }
         if (out.empty()) throw Usage("-o TABLE.cylt is required");
+        if (!sizes.empty() && config_out.empty()) throw Usage("--size is for the detector config: give --config-out");
         if (classes.empty()) throw Usage("give at least one --class NAME=LABEL");
         if (inputs.empty()) throw Usage("give the training images (files, directories or .list files)");
     } catch (const Usage &e) {
@@ -568,6 +585,13 @@ int learn_main(int argc, char **argv)
                     cfg.gate[c.index].aspect_min = c.aspect_min / aspect_margin;
                     cfg.gate[c.index].aspect_max = c.aspect_max * aspect_margin;
                 }
+            }
+            for (const auto &sz : sizes) {
+                int k = cyl_colortable_find_class(&t, sz.first.c_str());
+                if (k < 0) throw Error("--size: the table has no class '" + sz.first + "'");
+                cfg.observe.size[k].diameter_m = sz.second.first;
+                cfg.observe.size[k].height_m = sz.second.second;
+                cfg.gate[k].size_gate = size_gate;
             }
             write_file_atomic(config_out, detector_config_yaml(cfg, t, "cyl detector config written by cyl-train learn "
                                                                        "(blob shape gates from the labelled boxes)"));

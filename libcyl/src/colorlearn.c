@@ -106,7 +106,7 @@ cyl_learn_params cyl_learn_params_default(void)
 {
     cyl_learn_params p;
     p.max_bg_fraction = 0.001;
-    p.smooth_sigma_cells = 2.0;
+    p.smooth_sigma_cells = 1.5;
     p.bg_uniform_weight = 0.02;
     p.min_likelihood_ratio = 4.0;
     p.min_positive_count = 0.5;

@@ -115,6 +115,9 @@ std::string report_json(const LearnResult &r, const cyl_colortable &t);
 
 struct ScoreOptions {
     DetectorConfig detector;        // segmentation settings and the gates that need no camera
+    const cyl_camera *camera = nullptr;  // if set (frames of its size): the blobs scored are those of the
+                                    // detector's observations (cylfe::Detector: the size gate at the measured
+                                    // range too, with the config's sizes); else every blob the gates keep
     double iou = 0.5;               // a box is found when a blob's box overlaps it this much
     uint32_t fp_min_area = 20;      // false positives counted from this area, px
     double min_box_px = 12;         // the "large boxes" figures: boxes at least this wide, px

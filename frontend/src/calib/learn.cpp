@@ -500,6 +500,9 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
     // one row per labelled box; false blobs too, with matched_iou "false_blob" and their area in
     // centroid_inside's column
     std::string csv = "image,class,x0_px,y0_px,x1_px,y1_px,best_iou,matched_iou,centroid_inside,class_px_share\n";
+    std::unique_ptr<Detector> det;
+    if (o.camera) det.reset(new Detector(t, *o.camera, o.detector));
+    std::vector<char> observed;   // per blob of the detector's segmentation: an observation kept it
     for (const std::string &path : images) {
         LabelledFrame l = load_labelled(path, false);
         const cyl_image &img = l.frame.img;
@@ -516,6 +519,16 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
         us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
         const double frame_px = (double)img.width * img.height;
         mpx_total += frame_px / 1e6;
+        if (det) {
+            if (img.width != o.camera->width || img.height != o.camera->height)
+                throw Error(path + ": the image is " + std::to_string(img.width) + "x" + std::to_string(img.height) +
+                            " px but the camera's frames are " + std::to_string(o.camera->width) + "x" +
+                            std::to_string(o.camera->height));
+            const std::vector<cyl_observation> &obs = det->process(img);
+            observed.assign(det->segmentation().n_blobs, 0);
+            for (const cyl_observation &ob : obs) observed[ob.blob] = 1;
+        }
+        const cyl_segmentation &sg = det ? det->segmentation() : seg;
         cv::Mat vis;
         if (!o.overlay_dir.empty()) {
             vis = calib::classified_overlay(t, l.frame, 0.5);
@@ -527,10 +540,10 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
             const unsigned k = idx[ci];
             std::vector<const cyl_blob *> blobs;
             uint64_t class_px = 0;
-            for (uint32_t b = seg.class_first[k]; b < seg.class_first[k] + seg.class_count[k]; b++) {
-                class_px += seg.blobs[b].area;
-                if (!blob_passes(o.detector, seg.blobs[b], img.width, img.height)) continue;
-                blobs.push_back(&seg.blobs[b]);
+            for (uint32_t b = sg.class_first[k]; b < sg.class_first[k] + sg.class_count[k]; b++) {
+                class_px += sg.blobs[b].area;
+                if (det ? !observed[b] : !blob_passes(o.detector, sg.blobs[b], img.width, img.height)) continue;
+                blobs.push_back(&sg.blobs[b]);
             }
             if ((double)class_px > o.flood_fraction * frame_px) cs.flooded_frames++;
             std::vector<const Box *> boxes;

@@ -100,7 +100,7 @@ typedef struct cyl_learn_params {
     double max_bg_fraction;      /* false-positive rate: the share of the background density a class
                                     may claim, 0..1 (default 0.001) */
     double smooth_sigma_cells;   /* Gaussian smoothing of both histograms, sigma in cells per axis
-                                    (a cell is 8 Y and 4 U/V levels), 0 = none (default 2.0) */
+                                    (a cell is 8 Y and 4 U/V levels), 0 = none (default 1.5) */
     double bg_uniform_weight;    /* weight of the uniform colour density mixed into the background
                                     model, 0..1 (default 0.02) */
     double min_likelihood_ratio; /* a cell with a smaller ratio is never claimed (default 4) */
