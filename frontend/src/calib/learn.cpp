@@ -363,7 +363,8 @@ LearnResult learn_core(cyl_colortable &t, size_t n_images, const std::function<L
                                         work.size() * sizeof(float), rep.data());
     if (s == CYL_ERR_EMPTY)
         throw Error("learning claimed no colour for a class at the false-positive rate " + num(o.params.max_bg_fraction) +
-                    ": its colours are as common in the background as in its boxes (raise --fpr or label more)");
+                    ": its colours are as common in the background, or around its boxes, as in them (raise --fpr, lower "
+                    "--surround-weight, or label more)");
     check(s, "learning the colour classes");
     for (size_t i = 0; i < nc; i++) res.classes[i].r = rep[i];
 
