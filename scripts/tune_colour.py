@@ -92,8 +92,8 @@ def main():
     ap.add_argument("--build", default="build")
     ap.add_argument("--quick", action="store_true", help="a small grid")
     ap.add_argument("--grid", action="append", default=[], metavar="KEY=V1,V2,...",
-                    help="replace one learning grid axis (fpr, smooth, weak_fpr, min_weak_ratio, gains and "
-                         "colour_temps as V1/V2/..., surround, surround_weight), e.g. --grid surround_weight=0,1")
+                    help="replace one learning grid axis (fpr, smooth, weak_fpr, min_weak_ratio, gains, "
+                         "colour_temps and white_lifts as V1/V2/..., surround, surround_weight), e.g. --grid surround_weight=0,1")
     ap.add_argument("--gate-grid", action="append", default=[], metavar="KEY=V1,V2,...",
                     help="replace one gate grid axis (aspect_margin, min_fill, merge_gap, size_gate: 0 scores the "
                          "rendered scene without its camera)")
@@ -111,6 +111,7 @@ def main():
         "min_weak_ratio": [1.5] if a.quick else [1.5, 3.0],
         "gains": ["1"] if a.quick else ["1", "0.8,1,1.25"],
         "colour_temps": ["0"],
+        "white_lifts": ["0"] if a.quick else ["0", "0,16", "0,16,32"],
         "surround": [0.25],
         "surround_weight": [0.5],
     }
@@ -118,10 +119,10 @@ def main():
         key, _, vals = g.partition("=")
         if key not in learn_grid or not vals:
             ap.error(f"--grid {g}: KEY=V1,V2,... with KEY one of {', '.join(learn_grid)}")
-        learn_grid[key] = [v.replace("/", ",") for v in vals.split(",")] if key in ("gains", "colour_temps") else \
+        learn_grid[key] = [v.replace("/", ",") for v in vals.split(",")] if key in ("gains", "colour_temps", "white_lifts") else \
             [float(v) for v in vals.split(",")]
     gate_grid = {
-        "aspect_margin": [1.5],  # 1.25 and 2 did no better on the first grid
+        "aspect_margin": [2.0],  # 1.25 and 1.5 did no better (gate grid after the white lifts)
         "min_fill": [0.3],      # 0.5 loses cones (a triangle fills half its box); 0 keeps lines
         "merge_gap": [3],       # 8 changed nothing on the first 59 candidates
         "size_gate": [2.0],     # the rendered scene's, scored with its camera (1.5-3 tried: the same)
@@ -141,9 +142,9 @@ def main():
         hard_imgs = sorted(os.path.join(hard_dir, "images", f) for f in os.listdir(os.path.join(hard_dir, "images")))
         hard_cam = os.path.join(hard_dir, "camera.yaml")
         run([os.path.join(a.build, "cyl-render"), "-S", "hard", "--write-camera", hard_cam])
-        for fpr, smooth, wfpr, wratio, gains, temps, sur, surw in itertools.product(*learn_grid.values()):
+        for fpr, smooth, wfpr, wratio, gains, temps, lifts, sur, surw in itertools.product(*learn_grid.values()):
             la = ["--fpr", str(fpr), "--smooth", str(smooth), "--weak-fpr", str(wfpr), "--min-weak-ratio", str(wratio),
-                  "--gains", gains, "--colour-temps", temps, "--surround", str(sur), "--surround-weight", str(surw)]
+                  "--gains", gains, "--colour-temps", temps, "--white-lifts", lifts, "--surround", str(sur), "--surround-weight", str(surw)]
             learned = {}
             learned["hard"] = learn(a.build, tmp, "hard", hard_imgs[:1], [("orange", 0), ("green", 1)], la)
             for y in years:
@@ -182,7 +183,7 @@ def main():
                                   + max(0.0, fp - 1.0) + max(0.0, hard_fp - 0.2))
                 mean_recall = sum(rec.values()) / len(rec)   # breaks ties of the objective
                 row = {"fpr": fpr, "smooth": smooth, "weak_fpr": wfpr, "min_weak_ratio": wratio, "gains": gains,
-                       "colour_temps": temps, "surround": sur, "surround_weight": surw,
+                       "colour_temps": temps, "white_lifts": lifts, "surround": sur, "surround_weight": surw,
                        "aspect_margin": margin, "min_fill": fill, "hard_fp": round(hard_fp, 2),
                        "merge_gap": gap, "size_gate": size_gate, **{k: round(v, 3) for k, v in rec.items()}, "fp_max": round(fp, 2),
                        "objective": round(objective, 3), "mean_recall": round(mean_recall, 3)}

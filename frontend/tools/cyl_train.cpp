@@ -39,11 +39,12 @@ const char *kUsage =
     "rate (cyl/colorlearn.h). Prints a report per class. Options:\n"
     "  --class NAME=LABEL[@INDEX]  learn class NAME from the boxes with label id LABEL (repeatable;\n"
     "                      INDEX: its table index, lower wins where box classes overlap)\n"
-    "  --fpr F             share of background pixels a class may claim (default 0.001)\n"
+    "  --fpr F             share of background pixels a class may claim (default 0.0005)\n"
     "  --smooth S          smoothing of the colour histograms, cells (default 1.5)\n"
     "  --min-ratio R       never claim a colour less than R times likelier in the class (default 4)\n"
     "  --weak-fpr F        share of background the class and its weak class NAME~ may claim together\n"
-    "                      (default 0.03); weak pixels count only where they touch the class's own\n"
+    "                      (default 0.01, raised to --fpr if that is larger); weak pixels count only\n"
+    "                      where they touch the class's own\n"
     "  --min-share S       each class keeps at least S of its boxes' pixels, the threshold lowered\n"
     "                      below the rate's if need be (default 0: the rate alone)\n"
     "  --unseen W          weight of a uniform colour density in the background model: how likely a\n"
@@ -55,6 +56,8 @@ const char *kUsage =
     "                      (the light or exposure changing; default 0.8,1,1.25)\n"
     "  --colour-temps T1,T2,...  ... and at each of these light colours: red gain 1+T, blue gain\n"
     "                      1/(1+T) (T > 0 warmer, < 0 cooler; -0.45..1; default 0: as taken)\n"
+    "  --white-lifts W1,W2,...  ... and with a white light of W levels added to every channel (a\n"
+    "                      highlight: brighter and paler; -255..255; default 0,16)\n"
     "  --inset F           trim F of each box's size off every side before counting (default 0)\n"
     "  --surround F        each class's surround: the background within F of a box's width/height\n"
     "                      (at least 2 px) around its boxes (default 0.25; 0: none)\n"
@@ -66,7 +69,7 @@ const char *kUsage =
     "  --report FILE.json  also write the report as JSON\n"
     "  --config-out FILE.yaml  write a detector config (cyl detect --config, cyl-score --config) with\n"
     "                      each class's blob shape gate from its boxes: aspect_range = the boxes'\n"
-    "                      width/height range widened by --aspect-margin (default 1.5) each way,\n"
+    "                      width/height range widened by --aspect-margin (default 2) each way,\n"
     "                      min_fill (default 0.3) and merge_gap_px (default 3)\n"
     "  --aspect-margin M, --min-fill F, --merge-gap N   (for --config-out)\n"
     "  --size NAME=D,H     (for --config-out, repeatable) the class's landmark diameter and height,\n"
@@ -472,7 +475,8 @@ int run_gui(Opts &o, cyl_colortable &t, const cyl_train_params &params)
 int learn_main(int argc, char **argv)
 {
     std::string out, base, report, config_out;
-    double aspect_margin = 1.5, min_fill = 0.3, size_gate = 2.0;
+    double aspect_margin = 2.0, min_fill = 0.3, size_gate = 2.0;
+    bool weak_fpr_given = false;
     std::vector<std::pair<std::string, std::pair<double, double>>> sizes;
     long merge_gap = 3;
     std::vector<learn::ClassSpec> classes;
@@ -516,21 +520,24 @@ int learn_main(int argc, char **argv)
             else if (s == "--negatives") negatives.push_back(next());
             else if (s == "--all-boxes-ignored") lo.other_boxes_negative = false;
             else if (s == "--no-weak") lo.weak = false;
-            else if (s == "--gains" || s == "--colour-temps") {
-                const bool gains = s == "--gains";
-                std::vector<double> &list = gains ? lo.gains : lo.colour_temperatures;
+            else if (s == "--gains" || s == "--colour-temps" || s == "--white-lifts") {
+                const bool gains = s == "--gains", lifts = s == "--white-lifts";
+                std::vector<double> &list = gains ? lo.gains : lifts ? lo.white_lifts : lo.colour_temperatures;
                 std::string v = next();
                 list.clear();
                 size_t pos = 0;
                 while (pos <= v.size()) {
                     size_t c = v.find(',', pos);
                     list.push_back(parse_num(s, v.substr(pos, c == std::string::npos ? std::string::npos : c - pos),
-                                             gains ? 0.1 : -0.45, gains ? 10 : 1, false));
+                                             gains ? 0.1 : lifts ? -255 : -0.45, gains ? 10 : lifts ? 255 : 1, false));
                     if (c == std::string::npos) break;
                     pos = c + 1;
                 }
             }
-            else if (s == "--weak-fpr") lo.params.weak_bg_fraction = parse_num(s, next(), 0, 1, false);
+            else if (s == "--weak-fpr") {
+                lo.params.weak_bg_fraction = parse_num(s, next(), 0, 1, false);
+                weak_fpr_given = true;
+            }
             else if (s == "--min-share") lo.params.min_class_share = parse_num(s, next(), 0, 1, false);
             else if (s == "--unseen") lo.params.bg_uniform_weight = parse_num(s, next(), 0, 1, false);
             else if (s == "--min-weak-ratio") lo.params.min_weak_ratio = parse_num(s, next(), 0, 1e9, false);
@@ -555,6 +562,11 @@ int learn_main(int argc, char **argv)
         }
         if (out.empty()) throw Usage("-o TABLE.cylt is required");
         if (!sizes.empty() && config_out.empty()) throw Usage("--size is for the detector config: give --config-out");
+        // the class and its weak class together claim at least what the class alone does
+        if (lo.params.weak_bg_fraction < lo.params.max_bg_fraction) {
+            if (weak_fpr_given) throw Usage("--weak-fpr must be at least --fpr");
+            lo.params.weak_bg_fraction = lo.params.max_bg_fraction;
+        }
         if (classes.empty()) throw Usage("give at least one --class NAME=LABEL");
         if (inputs.empty()) throw Usage("give the training images (files, directories or .list files)");
     } catch (const Usage &e) {

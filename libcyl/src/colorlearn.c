@@ -38,18 +38,18 @@ static uint8_t clip_level(double x)
 /* A colour as it would be under the channel gains g (red, green, blue). Equal gains scale Y and
  * the chroma offsets (exposure); otherwise through R, G, B (BT.601 full range), each channel
  * clipped as a sensor would. */
-static void map_colour(uint8_t *Y, uint8_t *U, uint8_t *V, const double g[3])
+static void map_colour(uint8_t *Y, uint8_t *U, uint8_t *V, const double g[3], double white)
 {
-    if (g[0] == g[1] && g[1] == g[2]) {
+    if (g[0] == g[1] && g[1] == g[2] && white == 0.0) {
         if (g[0] == 1.0) return;
         *Y = scale_level(*Y, 0.0, g[0]);
         *U = scale_level(*U, 128.0, g[0]);
         *V = scale_level(*V, 128.0, g[0]);
     } else {
         const double u = (double)*U - 128.0, v = (double)*V - 128.0;
-        const double R = clip_channel(g[0] * ((double)*Y + 1.402 * v));
-        const double G = clip_channel(g[1] * ((double)*Y - 0.344136 * u - 0.714136 * v));
-        const double B = clip_channel(g[2] * ((double)*Y + 1.772 * u));
+        const double R = clip_channel(g[0] * ((double)*Y + 1.402 * v) + white);
+        const double G = clip_channel(g[1] * ((double)*Y - 0.344136 * u - 0.714136 * v) + white);
+        const double B = clip_channel(g[2] * ((double)*Y + 1.772 * u) + white);
         const double Yo = 0.299 * R + 0.587 * G + 0.114 * B;
         *Y = clip_level(Yo);
         *U = clip_level(128.0 + (B - Yo) / 1.772);
@@ -61,7 +61,7 @@ cyl_status cyl_colorhist_add(cyl_colorhist *h, const cyl_image *img, const cyl_r
                              const uint8_t *mask, size_t mask_stride, uint8_t mask_value)
 {
     const double one[3] = { 1.0, 1.0, 1.0 };
-    return cyl_colorhist_add_rgb_gains(h, img, roi, mask, mask_stride, mask_value, one);
+    return cyl_colorhist_add_light(h, img, roi, mask, mask_stride, mask_value, one, 0.0);
 }
 
 cyl_status cyl_colorhist_add_scaled(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
@@ -69,12 +69,12 @@ cyl_status cyl_colorhist_add_scaled(cyl_colorhist *h, const cyl_image *img, cons
                                     double gain)
 {
     const double g[3] = { gain, gain, gain };
-    return cyl_colorhist_add_rgb_gains(h, img, roi, mask, mask_stride, mask_value, g);
+    return cyl_colorhist_add_light(h, img, roi, mask, mask_stride, mask_value, g, 0.0);
 }
 
-cyl_status cyl_colorhist_add_rgb_gains(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
-                                       const uint8_t *mask, size_t mask_stride, uint8_t mask_value,
-                                       const double gain_rgb[3])
+cyl_status cyl_colorhist_add_light(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
+                                   const uint8_t *mask, size_t mask_stride, uint8_t mask_value,
+                                   const double gain_rgb[3], double white_add)
 {
     cyl_roi r;
     uint32_t x, y;
@@ -83,6 +83,7 @@ cyl_status cyl_colorhist_add_rgb_gains(cyl_colorhist *h, const cyl_image *img, c
     if (!h || !gain_rgb) return CYL_ERR_ARG;
     for (k = 0; k < 3; k++)
         if (!(gain_rgb[k] > 0.0 && gain_rgb[k] <= 16.0)) return CYL_ERR_ARG;
+    if (!(white_add >= -255.0 && white_add <= 255.0)) return CYL_ERR_ARG;
     s = cyl_image_check(img);
     if (s != CYL_OK) return s;
     if (mask && mask_stride < img->width) return CYL_ERR_SIZE;
@@ -94,7 +95,7 @@ cyl_status cyl_colorhist_add_rgb_gains(cyl_colorhist *h, const cyl_image *img, c
             uint32_t *c;
             if (m && m[x] != mask_value) continue;
             cyl_pixel_fetch(img, x, y, &Y, &U, &V);
-            map_colour(&Y, &U, &V, gain_rgb);
+            map_colour(&Y, &U, &V, gain_rgb, white_add);
             c = &h->count[cyl_yuv_cell(Y, U, V)];
             if (*c != UINT32_MAX) { (*c)++; h->total++; }
         }
@@ -105,12 +106,12 @@ cyl_status cyl_colorhist_add_rgb_gains(cyl_colorhist *h, const cyl_image *img, c
 cyl_learn_params cyl_learn_params_default(void)
 {
     cyl_learn_params p;
-    p.max_bg_fraction = 0.001;
+    p.max_bg_fraction = 0.0005;
     p.smooth_sigma_cells = 1.5;
     p.bg_uniform_weight = 0.02;
     p.min_likelihood_ratio = 4.0;
     p.min_positive_count = 0.5;
-    p.weak_bg_fraction = 0.03;
+    p.weak_bg_fraction = 0.01;
     p.min_weak_ratio = 1.5;
     p.min_class_share = 0.0;
     p.surround_weight = 0.5;

@@ -95,8 +95,11 @@ static void test_hist_add(void **state)
  * 1.2 and blue gain 1/1.2: R, G, B = 120, 100, 83.33; Y = 0.299 R + 0.587 G + 0.114 B = 104.08,
  * U = 128 + (B - Y) / 1.772 = 116.29, V = 128 + (R - Y) / 1.402 = 139.36 -> (104, 116, 139).
  * Near white (250, 128, 128): R = 300 clips to 255, B = 208.33; Y = 246.75, U = 106.32,
- * V = 133.89 -> (247, 106, 134). Equal gains are the exposure scaling. */
-static void test_hist_rgb_gains(void **state)
+ * V = 133.89 -> (247, 106, 134). Equal gains are the exposure scaling. White light added: grey
+ * (100, 128, 128) + 20 levels is (120, 128, 128); a saturated (100, 60, 200) + 32 is R, G, B =
+ * 232.9, 104.0, 11.5 -> (132, 60, 200): brighter, the same chroma; near white (250, 128, 128) + 20
+ * clips to (255, 128, 128). */
+static void test_hist_light(void **state)
 {
     canvas c;
     cyl_image img;
@@ -113,18 +116,29 @@ static void test_hist_rgb_gains(void **state)
     cap = canvas_format_size(&c, CYL_FMT_YUV444P, 0);
     buf = malloc(cap);
     assert_true(canvas_to_format(&c, CYL_FMT_YUV444P, 0, 0, buf, cap, &img));
-    assert_int_equal(cyl_colorhist_add_rgb_gains(h, &img, NULL, NULL, 0, 0, warm), CYL_OK);
+    assert_int_equal(cyl_colorhist_add_light(h, &img, NULL, NULL, 0, 0, warm, 0.0), CYL_OK);
     assert_int_equal(h->total, 48);
     assert_int_equal(h->count[cyl_yuv_cell(104, 116, 139)], 24);
     assert_int_equal(h->count[cyl_yuv_cell(247, 106, 134)], 24);
     cyl_colorhist_clear(h);
-    assert_int_equal(cyl_colorhist_add_rgb_gains(h, &img, NULL, NULL, 0, 0, equal), CYL_OK);
+    assert_int_equal(cyl_colorhist_add_light(h, &img, NULL, NULL, 0, 0, equal, 0.0), CYL_OK);
     assert_int_equal(cyl_colorhist_add_scaled(h2, &img, NULL, NULL, 0, 0, 1.25), CYL_OK);
     for (k = 0; k < CYL_YUV_CELLS; k++) assert_int_equal(h->count[k], h2->count[k]);
-    assert_int_equal(cyl_colorhist_add_rgb_gains(h, &img, NULL, NULL, 0, 0, bad), CYL_ERR_ARG);
+    assert_int_equal(cyl_colorhist_add_light(h, &img, NULL, NULL, 0, 0, bad, 0.0), CYL_ERR_ARG);
     bad[1] = 17.0;
-    assert_int_equal(cyl_colorhist_add_rgb_gains(h, &img, NULL, NULL, 0, 0, bad), CYL_ERR_ARG);
-    assert_int_equal(cyl_colorhist_add_rgb_gains(h, &img, NULL, NULL, 0, 0, NULL), CYL_ERR_ARG);
+    assert_int_equal(cyl_colorhist_add_light(h, &img, NULL, NULL, 0, 0, bad, 0.0), CYL_ERR_ARG);
+    assert_int_equal(cyl_colorhist_add_light(h, &img, NULL, NULL, 0, 0, NULL, 0.0), CYL_ERR_ARG);
+    cyl_colorhist_clear(h);
+    bad[1] = 1.0;
+    assert_int_equal(cyl_colorhist_add_light(h, &img, NULL, NULL, 0, 0, bad, 20.0), CYL_OK);
+    assert_int_equal(h->count[cyl_yuv_cell(120, 128, 128)], 24);
+    assert_int_equal(h->count[cyl_yuv_cell(255, 128, 128)], 24);
+    assert_int_equal(cyl_colorhist_add_light(h, &img, NULL, NULL, 0, 0, bad, 256.0), CYL_ERR_ARG);
+    canvas_rect(&c, 0, 0, 8, 6, 100, 60, 200);
+    assert_true(canvas_to_format(&c, CYL_FMT_YUV444P, 0, 0, buf, cap, &img));
+    cyl_colorhist_clear(h);
+    assert_int_equal(cyl_colorhist_add_light(h, &img, NULL, NULL, 0, 0, bad, 32.0), CYL_OK);
+    assert_int_equal(h->count[cyl_yuv_cell(132, 60, 200)], 48);
     canvas_free(&c);
     free(buf); free(h); free(h2);
 }
@@ -226,6 +240,7 @@ static void test_surround_subtracted_hand_derived(void **state)
     cyl_colortable_init(t);
     cyl_colortable_set_class(t, 1, "x", 1, 2, 3);
     p.max_bg_fraction = 0.02;
+    p.weak_bg_fraction = 0.02;     /* the weak rate is at least the rate (no weak class here) */
 
     p.surround_weight = 1.0;       /* no surround given: the weight does nothing */
     assert_int_equal(cyl_colortable_learn(t, &lc, 1, neg, &p, work, ws, &r), CYL_OK);
@@ -260,6 +275,7 @@ static void test_surround_subtracted_hand_derived(void **state)
     /* a class whose every colour is as common around its boxes as in them is nothing */
     p = exact_params();
     p.max_bg_fraction = 0.02;
+    p.weak_bg_fraction = 0.02;
     p.surround_weight = 1.0;
     cyl_colorhist_clear(sur);
     put(sur, 120, 200, 60, 600);
@@ -465,7 +481,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hist_add),
-        cmocka_unit_test(test_hist_rgb_gains),
+        cmocka_unit_test(test_hist_light),
         cmocka_unit_test(test_rate_decides_hand_derived),
         cmocka_unit_test(test_surround_subtracted_hand_derived),
         cmocka_unit_test(test_overlap_resolved_by_ratio),

@@ -72,6 +72,8 @@ struct LearnOptions {
                                           // (cyl_colorhist_add_scaled: photometric augmentation)
     std::vector<double> colour_temperatures{0.0};  // ... and at each of these light colours: t gives red gain
                                           // 1 + t, blue gain 1 / (1 + t) (warmer for t > 0; -0.5 < t <= 1)
+    std::vector<double> white_lifts{0.0, 16.0};  // ... and with each of these white lights added, levels per channel
+                                          // (a highlight: brighter and paler; cyl_colorhist_add_light)
 };
 
 struct ClassReport {

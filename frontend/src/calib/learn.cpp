@@ -208,15 +208,16 @@ void paint(std::vector<uint8_t> &mask, int w, int h, const Box &b, double inset,
 }
 
 // Count the pixels of img whose mask byte equals value (mask null: all) into h, once per
-// exposure gain and colour temperature of the options (photometric augmentation).
+// exposure gain, colour temperature and added white light of the options (photometric augmentation).
 void count_augmented(cyl_colorhist *h, const cyl_image &img, const uint8_t *mask, size_t stride, uint8_t value,
                      const LearnOptions &o, const std::string &what)
 {
     for (double g : o.gains)
-        for (double t : o.colour_temperatures) {
-            const double rgb[3] = {g * (1.0 + t), g, g / (1.0 + t)};
-            check(cyl_colorhist_add_rgb_gains(h, &img, nullptr, mask, stride, value, rgb), what);
-        }
+        for (double t : o.colour_temperatures)
+            for (double wl : o.white_lifts) {
+                const double rgb[3] = {g * (1.0 + t), g, g / (1.0 + t)};
+                check(cyl_colorhist_add_light(h, &img, nullptr, mask, stride, value, rgb, wl), what);
+            }
 }
 
 } // namespace
@@ -235,7 +236,10 @@ LearnResult learn_core(cyl_colortable &t, size_t n_images, const std::function<L
     if (o.colour_temperatures.empty()) throw Error("no colour temperature to learn at");
     for (double t : o.colour_temperatures)
         if (!(t > -0.5 && t <= 1.0)) throw Error("colour temperature shift " + num(t) + " outside (-0.5, 1]");
-    const uint64_t passes = (uint64_t)(o.gains.size() * o.colour_temperatures.size());
+    if (o.white_lifts.empty()) throw Error("no white light to learn at");
+    for (double wl : o.white_lifts)
+        if (!(wl >= -255 && wl <= 255)) throw Error("white light " + num(wl) + " outside -255..255 levels");
+    const uint64_t passes = (uint64_t)(o.gains.size() * o.colour_temperatures.size() * o.white_lifts.size());
     const size_t nc = classes.size();
     std::vector<std::unique_ptr<cyl_colorhist>> pos(nc);
     for (auto &p : pos) { p.reset(new cyl_colorhist); cyl_colorhist_clear(p.get()); }

@@ -75,15 +75,17 @@ cyl_status cyl_colorhist_add_scaled(cyl_colorhist *h, const cyl_image *img, cons
                                     const uint8_t *mask, size_t mask_stride, uint8_t mask_value,
                                     double gain);
 
-/* Like cyl_colorhist_add_scaled(), with each pixel's colour as it would be under light of another
- * colour and brightness: the colour converted to R, G, B (BT.601, full range: R = Y + 1.402 (V - 128),
+/* Like cyl_colorhist_add_scaled(), with each pixel's colour as it would be under other light: the
+ * colour converted to R, G, B (BT.601, full range: R = Y + 1.402 (V - 128),
  * G = Y - 0.344 (U - 128) - 0.714 (V - 128), B = Y + 1.772 (U - 128)), each channel multiplied by its
- * gain (gain_rgb[0] red, [1] green, [2] blue; > 0 and <= 16), converted back, rounded and clipped to
- * 0..255. Equal gains g are cyl_colorhist_add_scaled() with gain g; red and blue gains apart model a
- * change of white balance or of the light's colour temperature (warmer: red up, blue down). */
-cyl_status cyl_colorhist_add_rgb_gains(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
-                                       const uint8_t *mask, size_t mask_stride, uint8_t mask_value,
-                                       const double gain_rgb[3]);
+ * gain (gain_rgb[0] red, [1] green, [2] blue; > 0 and <= 16) and white_add levels added to each
+ * (-255..255), clipped to 0..255 as a sensor would, converted back and rounded. Equal gains g with
+ * white_add 0 are cyl_colorhist_add_scaled() with gain g; red and blue gains apart model a change of
+ * white balance or of the light's colour temperature (warmer: red up, blue down); white_add > 0 a
+ * white light added (a highlight: brighter, chroma unchanged, so paler). */
+cyl_status cyl_colorhist_add_light(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
+                                   const uint8_t *mask, size_t mask_stride, uint8_t mask_value,
+                                   const double gain_rgb[3], double white_add);
 
 /* Empty histogram. */
 void cyl_colorhist_clear(cyl_colorhist *h);
@@ -98,7 +100,7 @@ cyl_status cyl_colorhist_add(cyl_colorhist *h, const cyl_image *img, const cyl_r
 
 typedef struct cyl_learn_params {
     double max_bg_fraction;      /* false-positive rate: the share of the background density a class
-                                    may claim, 0..1 (default 0.001) */
+                                    may claim, 0..1 (default 0.0005) */
     double smooth_sigma_cells;   /* Gaussian smoothing of both histograms, sigma in cells per axis
                                     (a cell is 8 Y and 4 U/V levels), 0 = none (default 1.5) */
     double bg_uniform_weight;    /* weight of the uniform colour density mixed into the background
@@ -108,7 +110,7 @@ typedef struct cyl_learn_params {
                                     pixels (default 0.5: stray single pixels claim nothing) */
     double weak_bg_fraction;     /* for classes with a weak class: the share of the background density
                                     the class and its weak class may claim together, >= max_bg_fraction
-                                    (default 0.03) */
+                                    (default 0.01) */
     double min_weak_ratio;       /* a weak cell's ratio is at least this (default 1.5) */
     double min_class_share;      /* the class keeps at least this share of its own training pixels,
                                     the threshold lowered below the rate's if need be (never under
