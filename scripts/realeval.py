@@ -72,6 +72,33 @@ def run(cmd):
     return p.stdout
 
 
+# the rendered scene's landmarks (cylinders of both classes), diameter and height, m
+HARD_LANDMARK_SIZE = "0.10,0.30"
+
+
+def class_args(classes):
+    """--class NAME=LABEL for each (name, label)."""
+    out = []
+    for c, label in classes:
+        out += ["--class", f"{c}={label}"]
+    return out
+
+
+def score(build, table, config, classes, test_list, calib=None, boxes=None):
+    """cyl-score on the images of test_list: (its text lines, the JSON of its last line)."""
+    out = run([os.path.join(build, "cyl-score"), "-q", "--table", table, "--config", config]
+              + (["--calib", calib] if calib else []) + (["--boxes", boxes] if boxes else [])
+              + class_args(classes) + [test_list])
+    lines = out.strip().splitlines()
+    return lines[:-1], json.loads(lines[-1])
+
+
+def pooled_recall(classes, key="recall_iou50"):
+    """One recall over the boxes of several classes of a cyl-score result."""
+    boxes = sum(c["boxes"] for c in classes.values())
+    return sum(c[key] * c["boxes"] for c in classes.values()) / max(boxes, 1)
+
+
 def learn_and_score(build, out, name, train, test, classes, learn_extra=(), calib=None):
     table = os.path.join(out, name + ".cylt")
     config = os.path.join(out, name + "-detector.yaml")
@@ -81,11 +108,8 @@ def learn_and_score(build, out, name, train, test, classes, learn_extra=(), cali
         f.write("\n".join(train) + "\n")
     with open(sl, "w") as f:
         f.write("\n".join(test) + "\n")
-    cls = []
-    for c, label in classes:
-        cls += ["--class", f"{c}={label}"]
-    text = run([os.path.join(build, "cyl-train"), "learn", "-q", "-o", table, "--report", report, "--config-out", config]
-               + cls + list(learn_extra) + [tl])
+    run([os.path.join(build, "cyl-train"), "learn", "-q", "-o", table, "--report", report, "--config-out", config]
+        + class_args(classes) + list(learn_extra) + [tl])
     with open(report) as f:
         rep = json.load(f)
     print(f"== {name}: learned on {len(train)} images, tested on {len(test)}")
@@ -94,11 +118,9 @@ def learn_and_score(build, out, name, train, test, classes, learn_extra=(), cali
               f"{100 * c['background_claimed']:.3f}%, largest frame share {100 * c['max_frame_share']:.2f}%")
         for w in c["warnings"]:
             print(f"   warning: {w}")
-    del text
-    score = run([os.path.join(build, "cyl-score"), "-q", "--table", table, "--config", config,
-                 "--boxes", os.path.join(out, name + "-boxes.csv")] + (["--calib", calib] if calib else []) + cls + [sl])
-    print("   " + "\n   ".join(score.strip().splitlines()[:-1]))
-    return json.loads(score.strip().splitlines()[-1])
+    text, res = score(build, table, config, classes, sl, calib, os.path.join(out, name + "-boxes.csv"))
+    print("   " + "\n   ".join(text))
+    return res
 
 
 def bearing_errors(obslog):
@@ -147,28 +169,23 @@ def hard_synth(build, out, frames, seed=3):
     run([os.path.join(build, "cyl-render"), "-S", "hard", "--write-camera", cam])
     # the landmarks' size goes into the detector config (the expected-size gate at the measured
     # range), and the scene's camera lets cyl-score score the detector's observations
+    table, config = os.path.join(out, "hard.cylt"), os.path.join(out, "hard-detector.yaml")
     sc = learn_and_score(build, out, "hard", imgs[:1], imgs[1:], classes,
-                         ["--size", "orange=0.10,0.30", "--size", "green=0.10,0.30"], cam)
+                         [a for c, _ in classes for a in ("--size", f"{c}={HARD_LANDMARK_SIZE}")], cam)["classes"]
     # the same without the camera: the blobs the camera-free gates keep, as on the real sets
-    nc = run([os.path.join(build, "cyl-score"), "-q", "--table", os.path.join(out, "hard.cylt"), "--config",
-              os.path.join(out, "hard-detector.yaml"), "--class", "orange=0", "--class", "green=1",
-              os.path.join(out, "hard-test.list")])
-    nc = json.loads(nc.strip().splitlines()[-1])["classes"]
+    nc = score(build, table, config, classes, os.path.join(out, "hard-test.list"))[1]["classes"]
     log = os.path.join(d, "obs.jsonl")
-    run([os.path.join(build, "cyl"), "detect", raw, "--table", os.path.join(out, "hard.cylt"), "--calib", cam,
-         "--config", os.path.join(out, "hard-detector.yaml"), "--size", "orange=0.10,0.30", "--size", "green=0.10,0.30",
+    # the config carries the landmarks' size
+    run([os.path.join(build, "cyl"), "detect", raw, "--table", table, "--calib", cam, "--config", config,
          "--quiet", "--out", log])
     errs = sorted(bearing_errors(log))
-    o, g = sc["classes"]["orange"], sc["classes"]["green"]
-    boxes = o["boxes"] + g["boxes"]
     res = {
         "hard_synth_frames": frames - 1,
-        "hard_synth_recall": (o["recall_iou50"] * o["boxes"] + g["recall_iou50"] * g["boxes"]) / max(boxes, 1),
-        "hard_synth_recall_centroid": (o["recall_centroid"] * o["boxes"] + g["recall_centroid"] * g["boxes"]) / max(boxes, 1),
-        "hard_synth_fp_per_frame": o["fp_per_image"] + g["fp_per_image"],
-        "hard_synth_recall_no_camera": (nc["orange"]["recall_iou50"] * o["boxes"] + nc["green"]["recall_iou50"] * g["boxes"])
-        / max(boxes, 1),
-        "hard_synth_fp_per_frame_no_camera": nc["orange"]["fp_per_image"] + nc["green"]["fp_per_image"],
+        "hard_synth_recall": pooled_recall(sc),
+        "hard_synth_recall_centroid": pooled_recall(sc, "recall_centroid"),
+        "hard_synth_fp_per_frame": sum(c["fp_per_image"] for c in sc.values()),
+        "hard_synth_recall_no_camera": pooled_recall(nc),
+        "hard_synth_fp_per_frame_no_camera": sum(c["fp_per_image"] for c in nc.values()),
         "hard_synth_bearing_err_median_deg": math.degrees(errs[len(errs) // 2]) if errs else None,
         "hard_synth_bearing_err_p95_deg": math.degrees(errs[int(0.95 * (len(errs) - 1))]) if errs else None,
         "hard_synth_observations_matched": len(errs),

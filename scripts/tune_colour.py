@@ -35,6 +35,10 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import realeval  # noqa: E402  (the splits live there, once)
 
 
+# the benchmark's recall targets (the distance objective)
+TARGETS = {"ball": 0.7, "cone": 0.9, "cube": 0.9, "hard": 0.95}
+
+
 def run(cmd):
     p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     if p.returncode != 0:
@@ -42,18 +46,11 @@ def run(cmd):
     return p.stdout
 
 
-def cls_args(classes):
-    out = []
-    for name, label in classes:
-        out += ["--class", f"{name}={label}"]
-    return out
-
-
 def learn(build, tmp, tag, train, classes, learn_args):
     table, rep, tl = (os.path.join(tmp, tag + ext) for ext in (".cylt", ".json", "-train.list"))
     with open(tl, "w") as f:
         f.write("\n".join(train) + "\n")
-    run([os.path.join(build, "cyl-train"), "learn", "-q", "-o", table, "--report", rep] + cls_args(classes)
+    run([os.path.join(build, "cyl-train"), "learn", "-q", "-o", table, "--report", rep] + realeval.class_args(classes)
         + learn_args + [tl])
     with open(rep) as f:
         return table, json.load(f)
@@ -61,7 +58,7 @@ def learn(build, tmp, tag, train, classes, learn_args):
 
 def gate_config(tmp, tag, report, margin, fill, gap, size=None, size_gate=0.0):
     """What cyl-train learn --config-out writes for these gate settings (checked against it in
-    make realeval, which uses --config-out itself); size: the landmarks' [diameter, height], m,
+    make realeval, which uses --config-out itself); size: the landmarks' "diameter,height", m,
     for the expected-size gate (scored with a camera)."""
     path = os.path.join(tmp, tag + ".yaml")
     lines = ["classes:"]
@@ -71,7 +68,7 @@ def gate_config(tmp, tag, report, margin, fill, gap, size=None, size_gate=0.0):
         if hi > 0:
             lines.append(f"    aspect_range: [{lo / margin:.6g}, {hi * margin:.6g}]")
         if size:
-            lines += [f"    size_m: [{size[0]}, {size[1]}]", f"    size_gate: {size_gate}"]
+            lines += [f"    size_m: [{size}]", f"    size_gate: {size_gate}"]
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")
     return path
@@ -81,9 +78,7 @@ def score(build, tmp, tag, table, cfg, test, classes, calib=None):
     sl = os.path.join(tmp, tag + "-test.list")
     with open(sl, "w") as f:
         f.write("\n".join(test) + "\n")
-    out = run([os.path.join(build, "cyl-score"), "-q", "--table", table, "--config", cfg] + cls_args(classes)
-              + (["--calib", calib] if calib else []) + [sl])
-    return json.loads(out.strip().splitlines()[-1])
+    return realeval.score(build, table, cfg, classes, sl, calib)[1]
 
 
 def main():
@@ -132,7 +127,6 @@ def main():
         if key not in gate_grid or not vals:
             ap.error(f"--gate-grid {g}: KEY=V1,V2,... with KEY one of {', '.join(gate_grid)}")
         gate_grid[key] = [int(v) if key == "merge_gap" else float(v) for v in vals.split(",")]
-    ap_hard_size = [0.10, 0.30]   # the rendered landmarks' diameter and height, m
     best = None
     with tempfile.TemporaryDirectory() as tmp:
         hard_dir = os.path.join(tmp, "hard")
@@ -166,20 +160,18 @@ def main():
                 c = gate_config(tmp, "frc", rep, margin, fill, gap)
                 frc = score(a.build, tmp, "frc", t, c, sets["frc"]["tune"], [("cone", 0), ("cube", 1)])["classes"]
                 t, rep = learned["hard"]
-                c = gate_config(tmp, "hard", rep, margin, fill, gap, ap_hard_size, size_gate)
+                c = gate_config(tmp, "hard", rep, margin, fill, gap, realeval.HARD_LANDMARK_SIZE, size_gate)
                 hd = score(a.build, tmp, "hard", t, c, hard_imgs[1:], [("orange", 0), ("green", 1)],
                            hard_cam if size_gate > 0 else None)["classes"]
-                hb = hd["orange"]["boxes"] + hd["green"]["boxes"]
-                hard_rec = (hd["orange"]["recall_iou50"] * hd["orange"]["boxes"] + hd["green"]["recall_iou50"] * hd["green"]["boxes"]) / max(hb, 1)
-                hard_fp = hd["orange"]["fp_per_image"] + hd["green"]["fp_per_image"]
+                hard_rec = realeval.pooled_recall(hd)
+                hard_fp = sum(c["fp_per_image"] for c in hd.values())
                 rec = {"ball": found / max(boxes, 1), "cone": frc["cone"]["recall_iou50"], "cube": frc["cube"]["recall_iou50"],
                        "hard": hard_rec}
                 fp = max(ball_fp, frc["cone"]["fp_per_image"], frc["cube"]["fp_per_image"])
                 if a.objective == "min":
                     objective = min(rec.values()) - max(0.0, fp - 0.8) - max(0.0, hard_fp - 0.2)
                 else:   # minus the distance from the targets
-                    targets = {"ball": 0.7, "cone": 0.9, "cube": 0.9, "hard": 0.95}
-                    objective = -(sum(max(0.0, targets[k] - rec[k]) for k in rec)
+                    objective = -(sum(max(0.0, TARGETS[k] - rec[k]) for k in rec)
                                   + max(0.0, fp - 1.0) + max(0.0, hard_fp - 0.2))
                 mean_recall = sum(rec.values()) / len(rec)   # breaks ties of the objective
                 row = {"fpr": fpr, "smooth": smooth, "weak_fpr": wfpr, "min_weak_ratio": wratio, "gains": gains,

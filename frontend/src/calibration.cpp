@@ -276,6 +276,15 @@ CameraCalibration load_camera_calibration(const std::string &path, bool lenient)
     }
 }
 
+CameraCalibration load_mounted_camera_calibration(const std::string &path, bool lenient)
+{
+    CameraCalibration cal = load_camera_calibration(path, lenient);
+    if (!cal.mount_known)
+        throw Error(path + ": no mount fields (mount_tilt_deg, mount_height_m, ...): range and bearing need the "
+                           "camera's mounting");
+    return cal;
+}
+
 void write_file_atomic(const std::string &path, const std::string &text)
 {
     OutputPlan plan = plan_output(path, ".tmp." + std::to_string(getpid()));

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -105,6 +106,24 @@ void read_class(const Reader &r, const YAML::Node &n, const std::string &where, 
 }
 
 } // namespace
+
+bool parse_size_option(const std::string &spec, std::string &name, cyl_landmark_size &size)
+{
+    const size_t eq = spec.find('=');
+    if (eq == std::string::npos || eq == 0) return false;
+    const char *p = spec.c_str() + eq + 1;
+    char *end = nullptr;
+    const double d = std::strtod(p, &end);
+    if (end == p || *end != ',') return false;
+    p = end + 1;
+    const double h = std::strtod(p, &end);
+    if (end == p || *end != '\0') return false;
+    if (!(d > 0 && d <= 1e3 && h > 0 && h <= 1e3)) return false;
+    name = spec.substr(0, eq);
+    size.diameter_m = d;
+    size.height_m = h;
+    return true;
+}
 
 void load_detector_config(const std::string &path, const cyl_colortable &table, DetectorConfig &cfg)
 {

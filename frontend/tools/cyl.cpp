@@ -334,10 +334,8 @@ int cmd_detect(const Args &a)
     cfg.observe.min_var_px2 = a.var_floor_px2;
     cyl_camera cam;
     if (!a.calib.empty()) {
-        CameraCalibration cal = load_camera_calibration(a.calib, a.lenient);
+        CameraCalibration cal = load_mounted_camera_calibration(a.calib, a.lenient);
         for (const std::string &w : cal.warnings) std::fprintf(stderr, "cyl: warning: %s\n", w.c_str());
-        if (!cal.mount_known) throw Error(a.calib + ": no mount fields (mount_tilt_deg, mount_height_m, ...): range "
-                                          "and bearing need the camera's mounting");
         cam = cal.cam;
     }
     if (synthetic) {
@@ -347,15 +345,12 @@ int cmd_detect(const Args &a)
             cfg.observe.size[i] = {scene.landmark_diameter_m, scene.landmark_height_m};
     }
     for (const std::string &s : a.sizes) {
-        size_t eq = s.find('=');
-        double d = 0, h = 0;
-        char comma = 0;
-        if (eq == std::string::npos || std::sscanf(s.c_str() + eq + 1, "%lf%c%lf", &d, &comma, &h) != 3 || comma != ',' ||
-            !(d > 0) || !(h > 0))
-            usage_error("--size: expected CLASS=DIAMETER,HEIGHT in m, got '" + s + "'");
-        int cls = cyl_colortable_find_class(&table, s.substr(0, eq).c_str());
-        if (cls < 0) usage_error("--size: class '" + s.substr(0, eq) + "' is not in " + table_path);
-        cfg.observe.size[cls] = {d, h};
+        std::string name;
+        cyl_landmark_size size{};
+        if (!parse_size_option(s, name, size)) usage_error("--size: expected CLASS=DIAMETER,HEIGHT in m, got '" + s + "'");
+        int cls = cyl_colortable_find_class(&table, name.c_str());
+        if (cls < 0) usage_error("--size: class '" + name + "' is not in " + table_path);
+        cfg.observe.size[cls] = size;
     }
     // A class without a size gets confidence 0 on every observation, and a SLAM back end that
     // filters on confidence then uses none of them: say so. (A weak class, NAME~, makes no blobs of

@@ -124,8 +124,7 @@ int main(int argc, char **argv)
     }
     try {
         if (cam_path.empty()) cam_path = cylfe::data_file("paper_camera.yaml");
-        cylfe::CameraCalibration cal = cylfe::load_camera_calibration(cam_path);
-        if (!cal.mount_known) throw cylfe::Error(cam_path + ": no mount_* fields: range and bearing need the mount");
+        cylfe::CameraCalibration cal = cylfe::load_mounted_camera_calibration(cam_path);
         const cyl_camera &cam = cal.cam;
         const char *mname = model == CYL_GEOM_EXACT ? "exact" : "paper";
         std::printf("libcyl uncertainty vs the paper -- camera %s, model %s, landmark %.2f x %.2f m, "

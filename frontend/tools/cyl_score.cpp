@@ -126,7 +126,7 @@ int main(int argc, char **argv)
         }
         cyl_camera cam{};
         if (!calib_path.empty()) {
-            cam = load_camera_calibration(calib_path).cam;
+            cam = load_mounted_camera_calibration(calib_path).cam;
             so.camera = &cam;
         }
         std::vector<std::string> images = learn::expand_images(inputs);

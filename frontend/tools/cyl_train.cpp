@@ -477,7 +477,7 @@ int learn_main(int argc, char **argv)
     std::string out, base, report, config_out;
     double aspect_margin = 2.0, min_fill = 0.3, size_gate = 2.0;
     bool weak_fpr_given = false;
-    std::vector<std::pair<std::string, std::pair<double, double>>> sizes;
+    std::vector<std::pair<std::string, cyl_landmark_size>> sizes;
     long merge_gap = 3;
     std::vector<learn::ClassSpec> classes;
     std::vector<std::string> inputs, negatives;
@@ -502,12 +502,10 @@ int learn_main(int argc, char **argv)
                 if (size_gate > 0 && size_gate < 1) throw Usage("--size-gate: 0 (off) or >= 1");
             }
             else if (s == "--size") {
-                std::string v = next();
-                size_t eq = v.find('='), comma = v.find(',', eq == std::string::npos ? 0 : eq);
-                if (eq == std::string::npos || eq == 0 || comma == std::string::npos)
-                    throw Usage("--size: expected NAME=D,H, got '" + v + "'");
-                sizes.push_back({v.substr(0, eq), {parse_num(s, v.substr(eq + 1, comma - eq - 1), 1e-6, 1e3, false),
-                                                   parse_num(s, v.substr(comma + 1), 1e-6, 1e3, false)}});
+                std::string v = next(), name;
+                cyl_landmark_size size{};
+                if (!parse_size_option(v, name, size)) throw Usage("--size: expected NAME=D,H in m, got '" + v + "'");
+                sizes.push_back({name, size});
             }
             else if (s == "--merge-gap") merge_gap = (long)parse_num(s, next(), -1, 1000, true);
             else if (s == "-q" || s == "--quiet") quiet = true;
@@ -601,8 +599,7 @@ int learn_main(int argc, char **argv)
             for (const auto &sz : sizes) {
                 int k = cyl_colortable_find_class(&t, sz.first.c_str());
                 if (k < 0) throw Error("--size: the table has no class '" + sz.first + "'");
-                cfg.observe.size[k].diameter_m = sz.second.first;
-                cfg.observe.size[k].height_m = sz.second.second;
+                cfg.observe.size[k] = sz.second;
                 cfg.gate[k].size_gate = size_gate;
             }
             write_file_atomic(config_out, detector_config_yaml(cfg, t, "cyl detector config written by cyl-train learn "

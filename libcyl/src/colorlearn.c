@@ -15,19 +15,12 @@ void cyl_colorhist_clear(cyl_colorhist *h)
     if (h) memset(h, 0, sizeof *h);
 }
 
-static uint8_t scale_level(uint8_t v, double centre, double gain)
-{
-    double x = centre + gain * ((double)v - centre);
-    if (x < 0.0) return 0;
-    if (x > 255.0) return 255;
-    return (uint8_t)floor(x + 0.5);
-}
-
 static double clip_channel(double x)
 {
     return x < 0.0 ? 0.0 : (x > 255.0 ? 255.0 : x);
 }
 
+/* x rounded to the nearest level and clipped to 0..255 */
 static uint8_t clip_level(double x)
 {
     if (!(x > 0.0)) return 0;
@@ -35,16 +28,17 @@ static uint8_t clip_level(double x)
     return (uint8_t)floor(x + 0.5);
 }
 
-/* A colour as it would be under the channel gains g (red, green, blue). Equal gains scale Y and
+/* A colour as it would be under the channel gains g (red, green, blue) with white levels added to
+ * each channel. Equal gains and no white light scale Y and
  * the chroma offsets (exposure); otherwise through R, G, B (BT.601 full range), each channel
  * clipped as a sensor would. */
 static void map_colour(uint8_t *Y, uint8_t *U, uint8_t *V, const double g[3], double white)
 {
     if (g[0] == g[1] && g[1] == g[2] && white == 0.0) {
         if (g[0] == 1.0) return;
-        *Y = scale_level(*Y, 0.0, g[0]);
-        *U = scale_level(*U, 128.0, g[0]);
-        *V = scale_level(*V, 128.0, g[0]);
+        *Y = clip_level(g[0] * (double)*Y);
+        *U = clip_level(128.0 + g[0] * ((double)*U - 128.0));
+        *V = clip_level(128.0 + g[0] * ((double)*V - 128.0));
     } else {
         const double u = (double)*U - 128.0, v = (double)*V - 128.0;
         const double R = clip_channel(g[0] * ((double)*Y + 1.402 * v) + white);

@@ -145,6 +145,8 @@ else
 fi
 expect score_camera_size 1 "is 640x480 px but the camera's frames are 768x576" -- \
   "$B/cyl-score" -q --table "$T/re/hard.cylt" --class orange=0 --calib calib_data/paper_camera.yaml "$T/h.list"
+expect score_camera_no_mount 1 "opencv_sample.yaml: no mount fields" -- \
+  "$B/cyl-score" -q --table "$T/re/hard.cylt" --class orange=0 --calib calib_data/opencv_sample.yaml "$T/h.list"
 
 echo "[==========] $((passed + failed)) tests ran."
 echo "[  PASSED  ] $passed tests."

@@ -46,6 +46,9 @@ struct CameraCalibration {
 // (cyl_camera_check).
 CameraCalibration load_camera_calibration(const std::string &path, bool lenient = false);
 
+// The same for measuring range and bearing: also an Error when the file has no mount fields.
+CameraCalibration load_mounted_camera_calibration(const std::string &path, bool lenient = false);
+
 // Write cam as OpenCV FileStorage YAML with libcyl's fields, through "<path>.tmp.<pid>" renamed
 // into place (a good file is never replaced by a partial one). The intrinsic covariance is left
 // out when cam.flags has CYL_CAM_INTR_COV_UNKNOWN, the mount_* fields when with_mount is false (an

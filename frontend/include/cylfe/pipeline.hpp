@@ -49,6 +49,9 @@ bool blob_passes(const DetectorConfig &cfg, const cyl_blob &b, uint32_t frame_wi
 // file's folder.
 void load_detector_config(const std::string &path, const cyl_colortable &table, DetectorConfig &cfg);
 
+// A landmark size option, "NAME=DIAMETER,HEIGHT" in m (each in (0, 1000]): false when malformed.
+bool parse_size_option(const std::string &spec, std::string &name, cyl_landmark_size &size);
+
 // The detector config file's text for cfg (what differs from the defaults), for the classes of table.
 std::string detector_config_yaml(const DetectorConfig &cfg, const cyl_colortable &table, const std::string &comment);
 
