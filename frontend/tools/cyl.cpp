@@ -349,7 +349,13 @@ int cmd_detect(const Args &a)
         cyl_landmark_size size{};
         if (!parse_size_option(s, name, size)) usage_error("--size: expected CLASS=DIAMETER,HEIGHT in m, got '" + s + "'");
         int cls = cyl_colortable_find_class(&table, name.c_str());
-        if (cls < 0) usage_error("--size: class '" + name + "' is not in " + table_path);
+        if (cls < 0) {
+            std::string msg = "--size: class '";
+            msg += name;
+            msg += "' is not in ";
+            msg += table_path;
+            usage_error(msg);
+        }
         cfg.observe.size[cls] = size;
     }
     // A class without a size gets confidence 0 on every observation, and a SLAM back end that
