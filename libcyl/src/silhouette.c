@@ -32,45 +32,44 @@ static double cross(const double *o, const double *a, const double *b)
     return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
 }
 
-cyl_status cyl_silhouette_bias_at(const cyl_camera *cam, double x_m, double y_m, const cyl_landmark_size *size,
-                                  double rel_sigma, double sigma_px, cyl_silhouette_bias *out)
+static void mount_of(const cyl_camera *cam, mount *mt)
 {
-    double p[NPTS][2], hull[NPTS + 1][2];
-    double r, xc, yc, a2 = 0.0, sx = 0.0, sy = 0.0, uc, vc, us, vs;
-    mount mt;
+    mt->offset_m = cam->offset_m;
+    mt->height_m = cam->height_m;
+    mt->cy = cos(cam->yaw_rad);
+    mt->sy = sin(cam->yaw_rad);
+    mt->ct = cos(cam->tilt_rad);
+    mt->st = sin(cam->tilt_rad);
+}
+
+/* The radius of the polygon of CYL_SILHOUETTE_POINTS points whose area is the circle's (an
+ * inscribed polygon of 48 points is 0.3% smaller). */
+static double polygon_radius(double r)
+{
+    return r * sqrt(6.283185307179586 / (CYL_SILHOUETTE_POINTS * sin(6.283185307179586 / CYL_SILHOUETTE_POINTS)));
+}
+
+/* The image (normalised coordinates) of the frustum between the circle of radius r1 at height z1
+ * and the circle of radius r0 at z0 (above the centroid plane), axis at robot-frame (x, y): the
+ * convex hull of the two circles' points, in hull[0 .. k-1] (k returned; 0 if a point is not in
+ * front of the camera or the hull is degenerate). */
+static int frustum_hull(const mount *mt, double x_m, double y_m, double z1, double r1, double z0, double r0,
+                        double hull[NPTS + 1][2])
+{
+    double p[NPTS][2];
     int i, j, k = 0, lower;
-    cyl_status s;
-    if (!cam || !size || !out || !isfinite(x_m) || !isfinite(y_m) || !(rel_sigma >= 0.0) || !isfinite(rel_sigma) ||
-        !(sigma_px >= 0.0) || !isfinite(sigma_px))
-        return CYL_ERR_ARG;
-    if (!(size->diameter_m > 0.0) || !(size->height_m > 0.0) || !isfinite(size->diameter_m) ||
-        !isfinite(size->height_m))
-        return CYL_ERR_ARG;
-    s = cyl_camera_check(cam);
-    if (s != CYL_OK) return s;
-    /* the radius of the polygon whose area is the circle's (an inscribed polygon of 48 points is
-     * 0.3% smaller) */
-    r = 0.5 * size->diameter_m *
-        sqrt(6.283185307179586 / (CYL_SILHOUETTE_POINTS * sin(6.283185307179586 / CYL_SILHOUETTE_POINTS)));
-    mt.offset_m = cam->offset_m;
-    mt.height_m = cam->height_m;
-    mt.cy = cos(cam->yaw_rad);
-    mt.sy = sin(cam->yaw_rad);
-    mt.ct = cos(cam->tilt_rad);
-    mt.st = sin(cam->tilt_rad);
-    {   /* the circle's points by rotation: two sines per call instead of two per point */
+    {   /* the circles' points by rotation: two sines per call instead of two per point */
         const double da = 6.283185307179586 / CYL_SILHOUETTE_POINTS, cd = cos(da), sd = sin(da);
         double ca = 1.0, sa = 0.0;
         for (i = 0; i < CYL_SILHOUETTE_POINTS; i++) {
-            const double px = x_m + r * ca, py = y_m + r * sa, t = ca * cd - sa * sd;
-            if (!to_normalised(&mt, px, py, 0.5 * size->height_m, &p[2 * i][0], &p[2 * i][1]) ||
-                !to_normalised(&mt, px, py, -0.5 * size->height_m, &p[2 * i + 1][0], &p[2 * i + 1][1]))
-                return CYL_ERR_NO_RANGE;
+            const double t = ca * cd - sa * sd;
+            if (!to_normalised(mt, x_m + r1 * ca, y_m + r1 * sa, z1, &p[2 * i][0], &p[2 * i][1]) ||
+                !to_normalised(mt, x_m + r0 * ca, y_m + r0 * sa, z0, &p[2 * i + 1][0], &p[2 * i + 1][1]))
+                return 0;
             sa = sa * cd + ca * sd;
             ca = t;
         }
     }
-    if (!to_normalised(&mt, x_m, y_m, 0.0, &xc, &yc)) return CYL_ERR_NO_RANGE;
     /* sort by (x, y): insertion sort, NPTS is small */
     for (i = 1; i < NPTS; i++) {
         double t0 = p[i][0], t1 = p[i][1];
@@ -81,8 +80,8 @@ cyl_status cyl_silhouette_bias_at(const cyl_camera *cam, double x_m, double y_m,
         p[j + 1][0] = t0;
         p[j + 1][1] = t1;
     }
-    /* Andrew's monotone chain: lower hull, then upper hull (counter-clockwise in x right, y down
-     * is clockwise on screen; the sign of the area is handled below) */
+    /* Andrew's monotone chain: lower hull, then upper hull (every hull comes out with the same
+     * orientation, so areas of hulls and of their clipped parts add and subtract) */
     for (i = 0; i < NPTS; i++) {
         while (k >= 2 && cross(hull[k - 2], hull[k - 1], p[i]) <= 0.0) k--;
         hull[k][0] = p[i][0];
@@ -97,41 +96,175 @@ cyl_status cyl_silhouette_bias_at(const cyl_camera *cam, double x_m, double y_m,
         k++;
     }
     k--;  /* the last point repeats the first */
-    if (k < 3) return CYL_ERR_NO_RANGE;
-    /* Area centroid in the image (shoelace), with the lens: each hull edge, straight in
-     * normalised coordinates, is cut into pieces of at most PIECE_PX px whose ends are projected
-     * through the lens model (each point once), so a large blob's distortion moves its centroid as
-     * it does in the image. */
-    {
-        double u0, v0;
-        cyl_camera_project(cam, hull[0][0], hull[0][1], &u0, &v0);
-        for (i = 0; i < k; i++) {
-            const double *a = hull[i], *b = hull[(i + 1) % k];
-            const double ex = (b[0] - a[0]) * cam->fx_px, ey = (b[1] - a[1]) * cam->fy_px;
-            const double len_px = sqrt(ex * ex + ey * ey);
-            const int pieces = 1 + (int)(len_px / PIECE_PX);
-            int m;
-            for (m = 1; m <= pieces; m++) {
-                double u1, v1, c;
-                const double t = (double)m / pieces;
-                cyl_camera_project(cam, a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), &u1, &v1);
-                c = u0 * v1 - u1 * v0;
-                a2 += c;
-                sx += (u0 + u1) * c;
-                sy += (v0 + v1) * c;
-                u0 = u1;
-                v0 = v1;
-            }
+    return k < 3 ? 0 : k;
+}
+
+/* Area moments of a polygon (normalised coordinates, n points) in the image, with the lens: each
+ * edge, straight in normalised coordinates, is cut into pieces of at most PIECE_PX px whose ends
+ * are projected through the lens model (each point once), so a large blob's distortion moves its
+ * centroid as it does in the image. Adds twice the signed area to m[0] and 6 x area x centroid
+ * to m[1], m[2] (shoelace). */
+static void pixel_moments(const cyl_camera *cam, const double (*poly)[2], int n, double m[3])
+{
+    double u0, v0;
+    int i;
+    if (n < 3) return;
+    cyl_camera_project(cam, poly[0][0], poly[0][1], &u0, &v0);
+    for (i = 0; i < n; i++) {
+        const double *a = poly[i], *b = poly[(i + 1) % n];
+        const double ex = (b[0] - a[0]) * cam->fx_px, ey = (b[1] - a[1]) * cam->fy_px;
+        const double len_px = sqrt(ex * ex + ey * ey);
+        const int pieces = 1 + (int)(len_px / PIECE_PX);
+        int k;
+        for (k = 1; k <= pieces; k++) {
+            double u1, v1, c;
+            const double t = (double)k / pieces;
+            cyl_camera_project(cam, a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), &u1, &v1);
+            c = u0 * v1 - u1 * v0;
+            m[0] += c;
+            m[1] += (u0 + u1) * c;
+            m[2] += (v0 + v1) * c;
+            u0 = u1;
+            v0 = v1;
         }
     }
-    if (!(fabs(a2) > 0.0)) return CYL_ERR_NO_RANGE;
-    us = sx / (3.0 * a2);
-    vs = sy / (3.0 * a2);
+}
+
+static cyl_status finish(const cyl_camera *cam, const double m[3], double xc, double yc, double rel_sigma,
+                         double sigma_px, cyl_silhouette_bias *out)
+{
+    double uc, vc;
+    if (!(fabs(m[0]) > 0.0)) return CYL_ERR_NO_RANGE;
     cyl_camera_project(cam, xc, yc, &uc, &vc);
-    out->du_px = us - uc;
-    out->dv_px = vs - vc;
+    out->du_px = m[1] / (3.0 * m[0]) - uc;
+    out->dv_px = m[2] / (3.0 * m[0]) - vc;
     out->var_u_px2 = rel_sigma * rel_sigma * out->du_px * out->du_px + sigma_px * sigma_px;
     out->var_v_px2 = rel_sigma * rel_sigma * out->dv_px * out->dv_px + sigma_px * sigma_px;
-    out->area_px2 = 0.5 * fabs(a2);
+    out->area_px2 = 0.5 * fabs(m[0]);
     return CYL_OK;
+}
+
+static int sigmas_ok(double rel_sigma, double sigma_px)
+{
+    return rel_sigma >= 0.0 && isfinite(rel_sigma) && sigma_px >= 0.0 && isfinite(sigma_px);
+}
+
+cyl_status cyl_silhouette_bias_at(const cyl_camera *cam, double x_m, double y_m, const cyl_landmark_size *size,
+                                  double rel_sigma, double sigma_px, cyl_silhouette_bias *out)
+{
+    double hull[NPTS + 1][2], m[3] = {0.0, 0.0, 0.0}, r, xc, yc;
+    mount mt;
+    int k;
+    cyl_status s;
+    if (!cam || !size || !out || !isfinite(x_m) || !isfinite(y_m) || !sigmas_ok(rel_sigma, sigma_px))
+        return CYL_ERR_ARG;
+    if (!(size->diameter_m > 0.0) || !(size->height_m > 0.0) || !isfinite(size->diameter_m) ||
+        !isfinite(size->height_m))
+        return CYL_ERR_ARG;
+    s = cyl_camera_check(cam);
+    if (s != CYL_OK) return s;
+    r = polygon_radius(0.5 * size->diameter_m);
+    mount_of(cam, &mt);
+    k = frustum_hull(&mt, x_m, y_m, 0.5 * size->height_m, r, -0.5 * size->height_m, r, hull);
+    if (!k || !to_normalised(&mt, x_m, y_m, 0.0, &xc, &yc)) return CYL_ERR_NO_RANGE;
+    pixel_moments(cam, (const double (*)[2])hull, k, m);
+    return finish(cam, m, xc, yc, rel_sigma, sigma_px, out);
+}
+
+/* subject (convex, n points) clipped to the convex polygon clip (nc points): Sutherland-Hodgman,
+ * the result in out (at most n + nc points), its count returned. */
+#define CLIP_MAX (2 * NPTS + 4)
+static int clip_convex(const double (*subject)[2], int n, const double (*clip)[2], int nc,
+                       double (*out)[2], double (*tmp)[2])
+{
+    double orient = 0.0;
+    int i, e, cnt = n;
+    for (i = 0; i < nc; i++) {
+        const double *a = clip[i], *b = clip[(i + 1) % nc];
+        orient += a[0] * b[1] - b[0] * a[1];
+    }
+    orient = orient > 0.0 ? 1.0 : -1.0;
+    for (i = 0; i < n; i++) {
+        out[i][0] = subject[i][0];
+        out[i][1] = subject[i][1];
+    }
+    for (e = 0; e < nc && cnt > 0; e++) {
+        const double *a = clip[e], *b = clip[(e + 1) % nc];
+        int j, m = 0;
+        for (j = 0; j < cnt; j++) {
+            tmp[j][0] = out[j][0];
+            tmp[j][1] = out[j][1];
+        }
+        for (j = 0; j < cnt; j++) {
+            const double *p = tmp[j], *q = tmp[(j + 1) % cnt];
+            const double dp = orient * cross(a, b, p), dq = orient * cross(a, b, q);
+            if (dp >= 0.0 && m < CLIP_MAX) {
+                out[m][0] = p[0];
+                out[m][1] = p[1];
+                m++;
+            }
+            if (((dp >= 0.0) != (dq >= 0.0)) && m < CLIP_MAX) {
+                const double t = dp / (dp - dq);
+                out[m][0] = p[0] + t * (q[0] - p[0]);
+                out[m][1] = p[1] + t * (q[1] - p[1]);
+                m++;
+            }
+        }
+        cnt = m;
+    }
+    return cnt;
+}
+
+cyl_status cyl_silhouette_bias_model(const cyl_camera *cam, double x_m, double y_m,
+                                     const cyl_landmark_model *model, double base_z_m, uint32_t band_mask,
+                                     double rel_sigma, double sigma_px, cyl_silhouette_bias *out)
+{
+    double hull[NPTS + 1][2], occ[NPTS + 1][2], cut[CLIP_MAX][2], tmp[CLIP_MAX][2];
+    double m[3] = {0.0, 0.0, 0.0}, z_band[CYL_MODEL_MAX_BANDS + 1], total = 0.0, xc, yc;
+    double r_bot, r_top;
+    mount mt;
+    int k, counted = 0;
+    cyl_status s;
+    if (!cam || !model || !out || !isfinite(x_m) || !isfinite(y_m) || !isfinite(base_z_m) ||
+        !sigmas_ok(rel_sigma, sigma_px))
+        return CYL_ERR_ARG;
+    s = cyl_landmark_models_check(model, 1);
+    if (s != CYL_OK) return CYL_ERR_ARG;
+    if (band_mask == 0 || (band_mask >> model->n_bands) != 0) return CYL_ERR_ARG;
+    s = cyl_camera_check(cam);
+    if (s != CYL_OK) return s;
+    mount_of(cam, &mt);
+    /* band k spans z_band[k + 1] .. z_band[k] (top to bottom; z above the centroid plane) */
+    for (k = 0; k < model->n_bands; k++) total += model->band_height_m[k];
+    z_band[model->n_bands] = base_z_m;
+    for (k = model->n_bands - 1; k >= 0; k--) z_band[k] = z_band[k + 1] + model->band_height_m[k];
+    r_bot = polygon_radius(0.5 * model->diameter_bottom_m);
+    r_top = model->shape == CYL_SHAPE_CONE ? polygon_radius(0.5 * model->diameter_top_m) : r_bot;
+#define RADIUS_AT(z) (r_bot + (r_top - r_bot) * ((z) - base_z_m) / total)
+    for (k = 0; k < model->n_bands; k++) {
+        const double z1 = z_band[k], z0 = z_band[k + 1];
+        double mk[3] = {0.0, 0.0, 0.0}, mc[3] = {0.0, 0.0, 0.0};
+        int nh, no = 0, nc;
+        if (!(band_mask & (1u << k))) continue;
+        nh = frustum_hull(&mt, x_m, y_m, z1, RADIUS_AT(z1), z0, RADIUS_AT(z0), hull);
+        if (!nh) return CYL_ERR_NO_RANGE;
+        pixel_moments(cam, (const double (*)[2])hull, nh, mk);
+        /* what hides part of the band: seen from above its top, the landmark above it; from below
+         * its bottom, the landmark below it (the whole is convex, so each part is a frustum) */
+        if (mt.height_m > z1 && k > 0)
+            no = frustum_hull(&mt, x_m, y_m, z_band[0], RADIUS_AT(z_band[0]), z1, RADIUS_AT(z1), occ);
+        else if (mt.height_m < z0 && k < model->n_bands - 1)
+            no = frustum_hull(&mt, x_m, y_m, z0, RADIUS_AT(z0), base_z_m, r_bot, occ);
+        if (no) {
+            nc = clip_convex((const double (*)[2])hull, nh, (const double (*)[2])occ, no, cut, tmp);
+            pixel_moments(cam, (const double (*)[2])cut, nc, mc);
+        }
+        m[0] += mk[0] - mc[0];
+        m[1] += mk[1] - mc[1];
+        m[2] += mk[2] - mc[2];
+        counted++;
+    }
+#undef RADIUS_AT
+    if (!counted || !to_normalised(&mt, x_m, y_m, 0.0, &xc, &yc)) return CYL_ERR_NO_RANGE;
+    return finish(cam, m, xc, yc, rel_sigma, sigma_px, out);
 }

@@ -24,6 +24,7 @@
 #include "cyl/status.h"
 #include "cyl/camera.h"
 #include "cyl/confidence.h"
+#include "cyl/landmark.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -50,6 +51,23 @@ typedef struct cyl_silhouette_bias {
  * camera. */
 cyl_status cyl_silhouette_bias_at(const cyl_camera *cam, double x_m, double y_m, const cyl_landmark_size *size,
                                   double rel_sigma, double sigma_px, cyl_silhouette_bias *out);
+
+/* The same for a landmark of several bands (cyl/landmark.h): the offset of the area centroid of
+ * the visible parts of the bands in band_mask (bit k: band k, counted from the top) from the image
+ * of the landmark's axis at the centroid plane. The landmark stands with its base base_z_m above
+ * the centroid plane (negative: below; for landmarks on the floor, minus the plane's height above
+ * the floor), its radius linear from the base to the top (a cylinder or a cone). The whole is
+ * convex, so band k's image is the convex hull of the images of its two circles, less what the
+ * rest of the landmark hides of it: seen from above the band's top, the hull of the part above it
+ * (its top cap is hidden unless it is the top band); from below its bottom, the part below. The
+ * overlap is a convex polygon clipped in normalised coordinates; areas and centroids are taken in
+ * pixels through the lens as above. The cylinder of cyl_silhouette_bias_at() is the one-band model
+ * with base_z_m = -height_m / 2. Stack: about 10 KB on 32-bit targets. Returns as
+ * cyl_silhouette_bias_at(); CYL_ERR_ARG also for a model that fails cyl_landmark_models_check() or
+ * a band_mask that is empty or names bands the model does not have. */
+cyl_status cyl_silhouette_bias_model(const cyl_camera *cam, double x_m, double y_m,
+                                     const cyl_landmark_model *model, double base_z_m, uint32_t band_mask,
+                                     double rel_sigma, double sigma_px, cyl_silhouette_bias *out);
 
 #ifdef __cplusplus
 }
