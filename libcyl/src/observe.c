@@ -29,13 +29,31 @@ size_t cyl_observe_work_size(const cyl_segmentation *seg, const cyl_observe_para
     return cyl_noise_work_size_seg(seg);
 }
 
+/* What the silhouette bias is computed for: a single-colour cylinder of a class's size, or the
+ * bands in band_mask of a landmark model standing base_z_m above the centroid plane. */
+typedef struct shape_ref {
+    const cyl_landmark_size *size;
+    const cyl_landmark_model *model;
+    double base_z_m;
+    uint32_t band_mask;
+} shape_ref;
+
+static cyl_status bias_of(const cyl_camera *cam, const cyl_observe_params *p, const shape_ref *sh, double x_m,
+                          double y_m, cyl_silhouette_bias *sb)
+{
+    if (sh->model)
+        return cyl_silhouette_bias_model(cam, x_m, y_m, sh->model, sh->base_z_m, sh->band_mask,
+                                         p->silhouette_rel_sigma, p->silhouette_sigma_px, sb);
+    return cyl_silhouette_bias_at(cam, x_m, y_m, sh->size, p->silhouette_rel_sigma, p->silhouette_sigma_px, sb);
+}
+
 /* The silhouette's geometric bias (cyl/silhouette.h) taken out of the measurement point: the
  * offset at the landmark's position, which comes from the point itself, so twice (on the synthetic
  * camera at 0.8-4 m one pass leaves the point up to 0.081 px from the image of the centre, two
  * 0.003 px). The offset's variance is added to the centroid's. On any failure the uncorrected
  * result stays. */
 static void correct_silhouette(cyl_observation *o, const cyl_camera *cam, const cyl_observe_params *p,
-                               const cyl_landmark_size *size, cyl_rb_result *rb)
+                               const shape_ref *sh, cyl_rb_result *rb)
 {
     const double var_cu = o->var_u_px2, var_cv = o->var_v_px2;   /* the centroid's own */
     int it;
@@ -43,7 +61,7 @@ static void correct_silhouette(cyl_observation *o, const cyl_camera *cam, const 
         cyl_silhouette_bias sb;
         cyl_rb_result r2;
         double u, v, vu, vv;
-        if (cyl_silhouette_bias_at(cam, rb->x_m, rb->y_m, size, p->silhouette_rel_sigma, p->silhouette_sigma_px, &sb) != CYL_OK) return;
+        if (bias_of(cam, p, sh, rb->x_m, rb->y_m, &sb) != CYL_OK) return;
         u = o->centroid_u_px - sb.du_px;
         v = o->centroid_v_px - sb.dv_px;
         vu = var_cu + sb.var_u_px2;
@@ -94,26 +112,65 @@ static void calib_share(cyl_observation *o, const cyl_camera *cam, const cyl_rb_
         }
 }
 
+/* From the measurement point's centroid and variances (o->centroid_*, o->var_*) and box (w_px,
+ * h_px): the silhouette correction, range and bearing with their covariances, the calibration's
+ * share, the non-linearity flag and the confidence against the expected box of conf_size. */
+static void locate(cyl_observation *o, const cyl_camera *cam, const cyl_observe_params *p, const shape_ref *sh,
+                   const cyl_landmark_size *conf_size, uint32_t blob_flags)
+{
+    cyl_rb_result rb;
+    cyl_status st = cyl_rb_compute(cam, p->model, o->u_px, o->v_px, o->var_u_px2, o->var_v_px2, 0.0, &rb);
+    if (st == CYL_OK && p->silhouette_rel_sigma >= 0.0 && p->silhouette_sigma_px >= 0.0 && !(o->flags & CYL_OBS_CUT) &&
+        (sh->model || (sh->size->diameter_m > 0.0 && sh->size->height_m > 0.0)))
+        correct_silhouette(o, cam, p, sh, &rb);
+    if (st == CYL_ERR_NO_RANGE) {
+        o->flags |= CYL_OBS_NO_RANGE;
+        o->bearing_rad = rb.bearing_rad;
+        o->cov_rb[1][1] = rb.cov_rb[1][1];
+        return;
+    }
+    if (st != CYL_OK) { o->flags |= CYL_OBS_INVALID; return; }
+    o->range_m = rb.range_m;
+    o->bearing_rad = rb.bearing_rad;
+    memcpy(o->cov_rb, rb.cov_rb, sizeof o->cov_rb);
+    o->x_m = rb.x_m;
+    o->y_m = rb.y_m;
+    memcpy(o->cov_xy, rb.cov_xy, sizeof o->cov_xy);
+    o->depth_m = rb.depth_m;
+    calib_share(o, cam, &rb);
+    if (p->nonlinear_rel_sigma > 0.0 && sqrt(rb.cov_rb[0][0]) > p->nonlinear_rel_sigma * rb.range_m)
+        o->flags |= CYL_OBS_NONLINEAR;
+    {
+        cyl_confidence c;
+        double we, he;
+        if (cyl_landmark_expected_size(cam, rb.xn, rb.yn, o->depth_m, conf_size, &we, &he) == CYL_OK &&
+            cyl_landmark_confidence_expected(o->w_px, o->h_px, we, he, blob_flags, &c) == CYL_OK) {
+            o->confidence = c.confidence;
+            o->confidence_uncut = c.confidence_uncut;
+            o->w_est_px = c.w_est_px;
+            o->h_est_px = c.h_est_px;
+        } else {
+            o->flags |= CYL_OBS_NO_SIZE;
+        }
+    }
+}
+
+static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *cam, const cyl_observe_params *p,
+                                size_t work_size, uint32_t cap, const void *out, const uint32_t *n_out);
+
 cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
                        const cyl_observe_params *p, void *work, size_t work_size,
                        cyl_observation *out, uint32_t cap, uint32_t *n_out)
 {
     uint32_t bi, n = 0;
     cyl_status st, ret = CYL_OK;
-    if (!seg || !cam || !p || !n_out || (cap > 0 && !out)) return CYL_ERR_ARG;
-    *n_out = 0;
-    if (seg->n_blobs > 0 && !seg->blobs) return CYL_ERR_ARG;
-    st = cyl_camera_check(cam);
+    if (n_out) *n_out = 0;
+    st = observe_check(seg, cam, p, work_size, cap, out, n_out);
     if (st != CYL_OK) return st;
-    if (work_size < cyl_observe_work_size(seg, p)) return CYL_ERR_NOMEM;
-    if (p->model != CYL_GEOM_EXACT && p->model != CYL_GEOM_PAPER) return CYL_ERR_ARG;
-    if (!(p->min_var_px2 >= 0.0)) return CYL_ERR_ARG;
-    if (p->estimator == CYL_NOISE_IMAGE && (!p->image || !p->table)) return CYL_ERR_ARG;
     for (bi = 0; bi < seg->n_blobs; bi++) {
         const cyl_blob *b = &seg->blobs[bi];
         cyl_observation *o;
         cyl_centroid_noise cn;
-        cyl_rb_result rb;
         if (b->cls >= CYL_MAX_CLASSES || !(p->class_mask & (1u << b->cls))) continue;
         if (b->area < p->min_area) continue;
         if (n == cap) { ret = CYL_TRUNCATED; break; }
@@ -127,6 +184,8 @@ cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
         memset(o, 0, sizeof *o);
         o->blob = bi;
         o->cls = b->cls;
+        o->model = CYL_NO_MODEL;
+        o->landmark_id = -1;
         o->flags = b->flags & (CYL_BLOB_TOUCH_ANY | CYL_BLOB_MERGED);
         if (b->flags & CYL_BLOB_TOUCH_ANY) o->flags |= CYL_OBS_CUT;
         o->area = cn.n;
@@ -136,39 +195,138 @@ cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
         o->var_v_px2 = cn.var_y_px2 > p->min_var_px2 ? cn.var_y_px2 : p->min_var_px2;
         o->w_px = (double)cn.box_w * (double)seg->x_step;
         o->h_px = (double)cn.box_h * (double)seg->y_step;
-        st = cyl_rb_compute(cam, p->model, o->u_px, o->v_px, o->var_u_px2, o->var_v_px2, 0.0, &rb);
-        if (st == CYL_OK && p->silhouette_rel_sigma >= 0.0 && p->silhouette_sigma_px >= 0.0 && !(o->flags & CYL_OBS_CUT) &&
-            p->size[b->cls].diameter_m > 0.0 && p->size[b->cls].height_m > 0.0)
-            correct_silhouette(o, cam, p, &p->size[b->cls], &rb);
-        if (st == CYL_ERR_NO_RANGE) {
-            o->flags |= CYL_OBS_NO_RANGE;
-            o->bearing_rad = rb.bearing_rad;
-            o->cov_rb[1][1] = rb.cov_rb[1][1];
-            continue;
-        }
-        if (st != CYL_OK) { o->flags |= CYL_OBS_INVALID; continue; }
-        o->range_m = rb.range_m;
-        o->bearing_rad = rb.bearing_rad;
-        memcpy(o->cov_rb, rb.cov_rb, sizeof o->cov_rb);
-        o->x_m = rb.x_m;
-        o->y_m = rb.y_m;
-        memcpy(o->cov_xy, rb.cov_xy, sizeof o->cov_xy);
-        o->depth_m = rb.depth_m;
-        calib_share(o, cam, &rb);
-        if (p->nonlinear_rel_sigma > 0.0 && sqrt(rb.cov_rb[0][0]) > p->nonlinear_rel_sigma * rb.range_m)
-            o->flags |= CYL_OBS_NONLINEAR;
         {
-            cyl_confidence c;
-            double we, he;
-            if (cyl_landmark_expected_size(cam, rb.xn, rb.yn, o->depth_m, &p->size[b->cls], &we, &he) == CYL_OK &&
-                cyl_landmark_confidence_expected(o->w_px, o->h_px, we, he, b->flags, &c) == CYL_OK) {
-                o->confidence = c.confidence;
-                o->confidence_uncut = c.confidence_uncut;
-                o->w_est_px = c.w_est_px;
-                o->h_est_px = c.h_est_px;
-            } else {
-                o->flags |= CYL_OBS_NO_SIZE;
+            shape_ref sh;
+            memset(&sh, 0, sizeof sh);
+            sh.size = &p->size[b->cls];
+            locate(o, cam, p, &sh, &p->size[b->cls], b->flags);
+        }
+    }
+    *n_out = n;
+    return ret;
+}
+
+static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *cam, const cyl_observe_params *p,
+                                size_t work_size, uint32_t cap, const void *out, const uint32_t *n_out)
+{
+    cyl_status st;
+    if (!seg || !cam || !p || !n_out || (cap > 0 && !out)) return CYL_ERR_ARG;
+    if (seg->n_blobs > 0 && !seg->blobs) return CYL_ERR_ARG;
+    st = cyl_camera_check(cam);
+    if (st != CYL_OK) return st;
+    if (work_size < cyl_observe_work_size(seg, p)) return CYL_ERR_NOMEM;
+    if (p->model != CYL_GEOM_EXACT && p->model != CYL_GEOM_PAPER) return CYL_ERR_ARG;
+    if (!(p->min_var_px2 >= 0.0)) return CYL_ERR_ARG;
+    if (p->estimator == CYL_NOISE_IMAGE && (!p->image || !p->table)) return CYL_ERR_ARG;
+    return CYL_OK;
+}
+
+cyl_status cyl_observe_groups(const cyl_segmentation *seg, const cyl_group *groups, uint32_t n_groups,
+                              const cyl_landmark_model *models, uint32_t n_models, double plane_height_m,
+                              const cyl_camera *cam, const cyl_observe_params *p, void *work, size_t work_size,
+                              cyl_observation *out, uint32_t cap, uint32_t *n_out)
+{
+    uint32_t gi, n = 0;
+    cyl_status st, ret = CYL_OK;
+    if (n_out) *n_out = 0;
+    st = observe_check(seg, cam, p, work_size, cap, out, n_out);
+    if (st != CYL_OK) return st;
+    if ((n_groups > 0 && !groups) || !(plane_height_m >= 0.0) || !isfinite(plane_height_m)) return CYL_ERR_ARG;
+    if (n_groups > 0) {
+        st = cyl_landmark_models_check(models, n_models);
+        if (st != CYL_OK) return st;
+    }
+    for (gi = 0; gi < n_groups; gi++)
+        if (groups[gi].model >= n_models) return CYL_ERR_ARG;
+    for (gi = 0; gi < n_groups; gi++) {
+        const cyl_group *g = &groups[gi];
+        const cyl_landmark_model *m = &models[g->model];
+        cyl_observation *o;
+        double sx = 0.0, sy = 0.0, vx = 0.0, vy = 0.0, total_h = 0.0;
+        double cn_n[CYL_MODEL_MAX_BANDS], cn_vx[CYL_MODEL_MAX_BANDS], cn_vy[CYL_MODEL_MAX_BANDS];
+        uint32_t mask = 0, first = CYL_NONE, blob_flags = 0, nsamp = 0;
+        int k;
+        shape_ref sh;
+        cyl_landmark_size whole;
+        for (k = 0; k < m->n_bands; k++) {
+            const uint32_t bi = g->blob[k];
+            const cyl_blob *b;
+            cyl_centroid_noise cn;
+            total_h += m->band_height_m[k];
+            cn_n[k] = 0.0;
+            if (bi == CYL_NONE) continue;
+            if (bi >= seg->n_blobs) return CYL_ERR_ARG;
+            b = &seg->blobs[bi];
+            if (p->estimator == CYL_NOISE_IMAGE)
+                st = cyl_noise_blob_image(seg, b, p->image, p->table, &p->image_noise, &cn);
+            else
+                st = cyl_noise_blob(seg, b, p->estimator, work, work_size, &cn);
+            if (st == CYL_ERR_EMPTY) continue;
+            if (st != CYL_OK) return st;
+            if (first == CYL_NONE) first = bi;
+            mask |= 1u << k;
+            blob_flags |= b->flags;
+            nsamp += cn.n;
+            cn_n[k] = (double)cn.n;
+            cn_vx[k] = cn.var_x_px2;
+            cn_vy[k] = cn.var_y_px2;
+            sx += (double)cn.n * cn.cx_px;
+            sy += (double)cn.n * cn.cy_px;
+        }
+        if (!mask || nsamp == 0) continue;
+        if (n == cap) { ret = CYL_TRUNCATED; break; }
+        for (k = 0; k < m->n_bands; k++) {
+            const double w = cn_n[k] / (double)nsamp;
+            if (cn_n[k] == 0.0) continue;
+            vx += w * w * cn_vx[k];
+            vy += w * w * cn_vy[k];
+        }
+        o = &out[n++];
+        memset(o, 0, sizeof *o);
+        o->blob = first;
+        o->cls = seg->blobs[first].cls;
+        o->model = g->model;
+        o->group_flags = g->flags;
+        o->landmark_id = g->id;
+        o->code_confidence = g->code_confidence;
+        o->flags = blob_flags & (CYL_BLOB_TOUCH_ANY | CYL_BLOB_MERGED);
+        if (blob_flags & CYL_BLOB_TOUCH_ANY) o->flags |= CYL_OBS_CUT;
+        o->area = nsamp;
+        o->centroid_u_px = o->u_px = sx / (double)nsamp;
+        o->centroid_v_px = o->v_px = sy / (double)nsamp;
+        o->var_u_px2 = vx > p->min_var_px2 ? vx : p->min_var_px2;
+        o->var_v_px2 = vy > p->min_var_px2 ? vy : p->min_var_px2;
+        o->w_px = (double)g->x1 - (double)g->x0 + (double)seg->x_step;
+        o->h_px = (double)g->y1 - (double)g->y0 + (double)seg->y_step;
+        /* The reference point: the landmark's axis at z_ref, the middle of its matched bands
+         * weighted by their side areas (height x mean diameter), so the silhouette offset that
+         * remains is small (a cone's colour sits low: from the centroid plane its offset would be
+         * tens of px, and neither the fixed-point iteration nor a relative uncertainty of it would
+         * be right). The camera's height is then counted from the plane at z_ref. */
+        {
+            double z = -plane_height_m, zw = 0.0, ww = 0.0;
+            const double d_top = m->shape == CYL_SHAPE_CONE ? m->diameter_top_m : m->diameter_bottom_m;
+            cyl_camera cam_ref = *cam;
+            for (k = m->n_bands - 1; k >= 0; k--) {
+                const double z0 = z, z1 = z + m->band_height_m[k];
+                const double d0 = m->diameter_bottom_m + (d_top - m->diameter_bottom_m) * (z0 + plane_height_m) / total_h;
+                const double d1 = m->diameter_bottom_m + (d_top - m->diameter_bottom_m) * (z1 + plane_height_m) / total_h;
+                const double w = m->band_height_m[k] * 0.5 * (d0 + d1);
+                if (mask & (1u << k)) {
+                    zw += w * 0.5 * (z0 + z1);
+                    ww += w;
+                }
+                z = z1;
             }
+            o->z_ref_m = ww > 0.0 ? zw / ww : 0.0;
+            cam_ref.height_m = cam->height_m - o->z_ref_m;
+            memset(&sh, 0, sizeof sh);
+            sh.model = m;
+            sh.base_z_m = -plane_height_m - o->z_ref_m;
+            sh.band_mask = mask;
+            whole.diameter_m = d_top > m->diameter_bottom_m ? d_top : m->diameter_bottom_m;
+            whole.height_m = total_h;
+            locate(o, &cam_ref, p, &sh, &whole, blob_flags);
         }
     }
     *n_out = n;

@@ -11,4 +11,9 @@
  * in front of the camera. */
 int cyl_test_ray_hits_cylinder(const cyl_camera *cam, double xn, double yn, double x0_m, double y0_m,
                                double diameter_m, double height_m);
+/* The ray through (xn, yn) against the solid frustum with its axis at robot-frame (x0_m, y0_m), from
+ * height zb_m (radius rb_m) to zt_m (radius rt_m) above the centroid plane: the height at which it
+ * first enters the solid, or NAN if it misses (the side by its quadratic, the caps as discs). */
+double cyl_test_frustum_entry_z(const cyl_camera *cam, double xn, double yn, double x0_m, double y0_m, double zb_m,
+                                double rb_m, double zt_m, double rt_m);
 #endif

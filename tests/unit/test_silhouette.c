@@ -91,39 +91,6 @@ static void test_straight_ahead_is_vertical(void **state)
 
 /* ---- landmarks of several bands (cyl_silhouette_bias_model) ---- */
 
-/* The ray through normalised (xn, yn) against the solid frustum with its axis at robot-frame
- * (x0, y0), from zb (radius rb) to zt (radius rt), z above the centroid plane: the height of the
- * first point where it enters, or NAN if it misses. Written from the conventions of
- * cylinder_ref.c: the side by its quadratic, the caps as discs, the smallest positive t. */
-static double entry_height(const cyl_camera *c, double xn, double yn, double x0, double y0, double zb, double rb,
-                           double zt, double rt)
-{
-    const double ct = cos(c->tilt_rad), st = sin(c->tilt_rad), cy = cos(c->yaw_rad), sy = sin(c->yaw_rad);
-    const double Yl = xn, Xl = ct - st * yn, Zl = st + ct * yn;
-    const double dx = cy * Xl + sy * Yl, dy = sy * Xl - cy * Yl, dz = -Zl;
-    const double ox = c->offset_m - x0, oy = -y0, oz = c->height_m;
-    const double k = (rt - rb) / (zt - zb), a0 = rb - k * zb;   /* R(z) = a0 + k z */
-    const double A = dx * dx + dy * dy - k * k * dz * dz;
-    const double B = 2 * (ox * dx + oy * dy - k * (a0 + k * oz) * dz);
-    const double C = ox * ox + oy * oy - (a0 + k * oz) * (a0 + k * oz);
-    double best = INFINITY, zbest = NAN, disc = B * B - 4 * A * C;
-    int i;
-    if (disc >= 0 && A != 0) {
-        for (i = -1; i <= 1; i += 2) {
-            double t = (-B + i * sqrt(disc)) / (2 * A), z = oz + t * dz;
-            if (t > 0 && z >= zb && z <= zt && a0 + k * z >= 0 && t < best) { best = t; zbest = z; }
-        }
-    }
-    if (dz != 0) {
-        double zs[2] = {zt, zb}, rs[2] = {rt, rb};
-        for (i = 0; i < 2; i++) {
-            double t = (zs[i] - oz) / dz, qx = ox + t * dx, qy = oy + t * dy;
-            if (t > 0 && qx * qx + qy * qy <= rs[i] * rs[i] && t < best) { best = t; zbest = zs[i]; }
-        }
-    }
-    return zbest;
-}
-
 /* ray-cast centroid of the visible parts of the bands in mask, minus the image of the axis point */
 static void reference_model(const cyl_camera *c, double x0, double y0, const cyl_landmark_model *m, double base_z,
                             unsigned mask, double *du, double *dv)
@@ -143,7 +110,7 @@ static void reference_model(const cyl_camera *c, double x0, double y0, const cyl
                 for (i = 0; i < ss; i++) {
                     double pu = u - 0.5 + (i + 0.5) / ss, pv = v - 0.5 + (j + 0.5) / ss, xn, yn, z;
                     if (cyl_camera_undistort(c, pu, pv, &xn, &yn) != CYL_OK) continue;
-                    z = entry_height(c, xn, yn, x0, y0, base_z, 0.5 * m->diameter_bottom_m, top, rt);
+                    z = cyl_test_frustum_entry_z(c, xn, yn, x0, y0, base_z, 0.5 * m->diameter_bottom_m, top, rt);
                     if (isnan(z)) continue;
                     for (k = 0; k < m->n_bands; k++)
                         if (z >= zb[k + 1] && z <= zb[k]) break;

@@ -30,6 +30,7 @@
 #include "cyl/noise.h"
 #include "cyl/confidence.h"
 #include "cyl/rangebearing.h"
+#include "cyl/landmark.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -110,7 +111,18 @@ typedef struct cyl_observation {
                                    [rad], height, offset [m]) */
     double cov_rb_frame[2][2];  /* cov_rb from the inputs that change frame to frame only (centroid
                                    noise) and the distortion terms: m^2, m rad, rad^2 */
+    /* Landmarks of several bands (cyl_observe_groups); a blob's observation (cyl_observe) has
+     * model CYL_NO_MODEL, group_flags 0, landmark_id -1 and code_confidence 0. */
+    uint16_t model;             /* index of the landmark model, or CYL_NO_MODEL */
+    uint32_t group_flags;       /* the group's CYL_GROUP_* bits */
+    int32_t landmark_id;        /* identity read from the landmark's code, or -1 (none, or not read
+                                   confidently: cyl/landmark.h) */
+    double code_confidence;     /* the group's code confidence, 0..1 */
+    double z_ref_m;             /* height above the centroid plane of the axis point the range and
+                                   bearing refer to (cyl_observe_groups; 0 for a blob's), m */
 } cyl_observation;
+
+#define CYL_NO_MODEL 0xFFFFu    /* cyl_observation.model of an observation made from one blob */
 
 /* The defaults above. */
 cyl_observe_params cyl_observe_params_default(void);
@@ -124,6 +136,26 @@ size_t cyl_observe_work_size(const cyl_segmentation *seg, const cyl_observe_para
 cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
                        const cyl_observe_params *p, void *work, size_t work_size,
                        cyl_observation *out, uint32_t cap, uint32_t *n_out);
+
+/* Observations of grouped landmarks (cyl_group_blobs, cyl/landmark.h), one per group of
+ * groups[0 .. n_groups-1], made as cyl_observe() makes them from a blob, with these differences:
+ *   - the centroid is that of all the group's samples, its variance sum_i (n_i / N)^2 var_i over
+ *     the member blobs (n_i samples each, N in all; their edges are independent), each var_i by
+ *     the chosen estimator;
+ *   - the measurement point is the image of the landmark's axis at height z_ref_m above the
+ *     centroid plane (the plane the camera's height_m refers to; the landmark stands on the floor
+ *     plane_height_m below it): the middle of the matched bands, weighted by their side areas. The
+ *     silhouette bias taken out is that of the matched bands (cyl_silhouette_bias_model) from that
+ *     point, and the range and bearing are those of the landmark's axis;
+ *   - the confidence compares the group's box with the expected box of the whole landmark (its
+ *     widest diameter, its total height); blob is the group's first member, area the samples of
+ *     all members; model, group_flags, landmark_id and code_confidence come from the group.
+ * p->size and p->class_mask are not used. Returns as cyl_observe(); CYL_ERR_ARG also for a group
+ * whose model index or blob indices are out of range, or plane_height_m < 0. */
+cyl_status cyl_observe_groups(const cyl_segmentation *seg, const cyl_group *groups, uint32_t n_groups,
+                              const cyl_landmark_model *models, uint32_t n_models, double plane_height_m,
+                              const cyl_camera *cam, const cyl_observe_params *p, void *work, size_t work_size,
+                              cyl_observation *out, uint32_t cap, uint32_t *n_out);
 
 /* Prior covariance of the calibration parameters of cyl_observation.jac_calib (fx fy cx cy tilt
  * yaw h s): the camera's intrinsic covariance block and the mount variances. */
