@@ -73,7 +73,11 @@ struct Reader {
     }
 };
 
-const std::vector<std::string> kTop = {"roi", "mask", "min_run_px", "classes"};
+const std::vector<std::string> kTop = {"roi", "mask", "min_run_px", "classes", "landmarks"};
+const std::vector<std::string> kLandmarks = {"plane_height_m", "grouping", "models"};
+const std::vector<std::string> kGrouping = {"overlap_min", "scale_tol", "gap_slack_px", "depression_max_deg",
+                                            "max_candidates"};
+const std::vector<std::string> kModel = {"name", "bands", "band_heights_m", "shape", "diameter_m", "id"};
 const std::vector<std::string> kClass = {"min_area_px", "max_area_px", "merge_gap_px", "merge_min_density", "size_m",
                                          "size_gate", "aspect_range", "min_fill"};
 
@@ -102,6 +106,112 @@ void read_class(const Reader &r, const YAML::Node &n, const std::string &where, 
     if (n["size_gate"]) {
         g.size_gate = r.number(n["size_gate"], where + ".size_gate", 0, 100, false);
         if (g.size_gate > 0 && g.size_gate < 1) r.fail(n["size_gate"], where + ".size_gate: 0 (off) or >= 1");
+    }
+}
+
+// landmarks: the band models of multi-colour landmarks (cyl/landmark.h)
+void read_landmarks(const Reader &r, const YAML::Node &n, const cyl_colortable &table, DetectorConfig &cfg)
+{
+    r.keys(n, "landmarks", kLandmarks);
+    if (!n["plane_height_m"]) r.fail(n, "landmarks: plane_height_m is required (the height above the floor of the "
+                                        "plane the camera's mount_height_m is counted from, m)");
+    cfg.plane_height_m = r.number(n["plane_height_m"], "landmarks.plane_height_m", 0, 100, false);
+    if (n["grouping"]) {
+        const YAML::Node g = n["grouping"];
+        r.keys(g, "landmarks.grouping", kGrouping);
+        if (g["overlap_min"]) cfg.group.overlap_min = r.number(g["overlap_min"], "landmarks.grouping.overlap_min", 0, 1, false);
+        if (g["scale_tol"]) cfg.group.scale_tol = r.number(g["scale_tol"], "landmarks.grouping.scale_tol", 0, 5, false);
+        if (g["gap_slack_px"])
+            cfg.group.gap_slack_px = r.number(g["gap_slack_px"], "landmarks.grouping.gap_slack_px", 0, 1000, false);
+        if (g["depression_max_deg"])
+            cfg.group.depression_max_deg =
+                r.number(g["depression_max_deg"], "landmarks.grouping.depression_max_deg", 0, 89, false);
+        if (g["max_candidates"])
+            cfg.group.max_candidates =
+                (uint32_t)r.number(g["max_candidates"], "landmarks.grouping.max_candidates", 1, 1e6, true);
+    }
+    const YAML::Node ms = n["models"];
+    if (!ms || !ms.IsSequence() || ms.size() == 0) r.fail(ms ? ms : n, "landmarks.models: expected a list of models");
+    cfg.models.clear();
+    cfg.model_names.clear();
+    for (size_t i = 0; i < ms.size(); i++) {
+        const YAML::Node m = ms[i];
+        const std::string where = "landmarks.models[" + std::to_string(i) + "]";
+        r.keys(m, where, kModel);
+        for (const char *req : {"name", "bands", "band_heights_m", "diameter_m"})
+            if (!m[req]) r.fail(m, where + ": " + req + " is required");
+        if (!m["name"].IsScalar() || m["name"].Scalar().empty()) r.fail(m["name"], where + ".name: expected a name");
+        const std::string name = m["name"].Scalar();
+        for (const std::string &other : cfg.model_names)
+            if (other == name) r.fail(m["name"], where + ".name: '" + name + "' names two models");
+        cyl_landmark_model md{};
+        md.id = -1;
+        const YAML::Node bands = m["bands"];
+        if (!bands.IsSequence() || bands.size() < 1 || bands.size() > CYL_MODEL_MAX_BANDS)
+            r.fail(bands, where + ".bands: expected a list of 1 to " + std::to_string(CYL_MODEL_MAX_BANDS) +
+                              " class names (or gap), top to bottom");
+        md.n_bands = (uint8_t)bands.size();
+        for (size_t k = 0; k < bands.size(); k++) {
+            if (!bands[k].IsScalar()) r.fail(bands[k], where + ".bands: expected class names");
+            const std::string b = bands[k].Scalar();
+            if (b == "gap") {
+                md.band_cls[k] = CYL_BAND_GAP;
+                continue;
+            }
+            const int cls = cyl_colortable_find_class(&table, b.c_str());
+            if (cls < 0) {
+                std::vector<std::string> names = {"gap"};
+                for (unsigned c = 0; c < CYL_MAX_CLASSES; c++)
+                    if (table.name[c][0]) names.push_back(table.name[c]);
+                r.fail(bands[k], where + ".bands: '" + b + "' is not a class of the table" + did_you_mean(b, names));
+            }
+            if (table.weak_of[cls] != CYL_CLASS_NONE)
+                r.fail(bands[k], where + ".bands: '" + b + "' is a weak class (its pixels join its class's blobs)");
+            md.band_cls[k] = (uint8_t)cls;
+        }
+        std::vector<double> h = r.list(m["band_heights_m"], where + ".band_heights_m", bands.size(), 1e-4, 100, false);
+        for (size_t k = 0; k < h.size(); k++) md.band_height_m[k] = h[k];
+        std::string shape = "cylinder";
+        if (m["shape"]) {
+            if (!m["shape"].IsScalar()) r.fail(m["shape"], where + ".shape: cylinder or cone");
+            shape = m["shape"].Scalar();
+        }
+        if (shape == "cylinder") {
+            md.shape = CYL_SHAPE_CYLINDER;
+            if (m["diameter_m"].IsSequence())
+                r.fail(m["diameter_m"], where + ".diameter_m: a cylinder has one diameter (a cone: [base, top])");
+            md.diameter_bottom_m = r.number(m["diameter_m"], where + ".diameter_m", 1e-4, 100, false);
+        } else if (shape == "cone") {
+            md.shape = CYL_SHAPE_CONE;
+            std::vector<double> d = r.list(m["diameter_m"], where + ".diameter_m", 2, 0, 100, false);
+            if (!(d[0] > 0)) r.fail(m["diameter_m"], where + ".diameter_m: the base diameter must be > 0");
+            md.diameter_bottom_m = d[0];
+            md.diameter_top_m = d[1];
+        } else {
+            r.fail(m["shape"], where + ".shape: '" + shape + "' is not cylinder or cone");
+        }
+        if (m["id"]) md.id = (int32_t)r.number(m["id"], where + ".id", 0, 2147483647.0, true);
+        cfg.models.push_back(md);
+        cfg.model_names.push_back(name);
+        const cyl_status st = cyl_landmark_models_check(cfg.models.data(), (uint32_t)cfg.models.size());
+        if (st != CYL_OK) {
+            if (md.band_cls[0] == CYL_BAND_GAP || md.band_cls[md.n_bands - 1] == CYL_BAND_GAP)
+                r.fail(bands, where + ".bands: the first and the last band must be classes, not gap");
+            for (size_t j = 0; j + 1 < cfg.models.size(); j++)
+                if (cfg.models[j].n_bands == md.n_bands &&
+                    std::equal(md.band_cls, md.band_cls + md.n_bands, cfg.models[j].band_cls))
+                    r.fail(bands, where + ".bands: the same bands as model '" + cfg.model_names[j] +
+                                      "' (the code would not tell them apart)");
+            r.fail(m, where + ": " + cyl_status_str(st));
+        }
+    }
+    std::vector<int32_t> ids;
+    for (size_t i = 0; i < cfg.models.size(); i++) {
+        if (cfg.models[i].id < 0) continue;
+        if (std::find(ids.begin(), ids.end(), cfg.models[i].id) != ids.end())
+            r.fail(ms[i]["id"], "landmarks.models[" + std::to_string(i) + "].id: " + std::to_string(cfg.models[i].id) +
+                                    " is the id of another model");
+        ids.push_back(cfg.models[i].id);
     }
 }
 
@@ -169,6 +279,7 @@ void load_detector_config(const std::string &path, const cyl_colortable &table, 
             throw Error(r.at(m) + ": mask: " + e.what());
         }
     }
+    if (root["landmarks"]) read_landmarks(r, root["landmarks"], table, cfg);
     if (root["classes"]) {
         const YAML::Node cl = root["classes"];
         std::vector<std::string> names = {"all"};
@@ -229,6 +340,27 @@ std::string detector_config_yaml(const DetectorConfig &cfg, const cyl_colortable
         if (!e.empty()) cls += "  " + std::string(table.name[k]) + ":\n" + e;
     }
     if (!cls.empty()) s += "classes:\n" + cls;
+    if (!cfg.models.empty()) {
+        std::snprintf(b, sizeof b, "landmarks:\n  plane_height_m: %.6g\n  models:\n", cfg.plane_height_m);
+        s += b;
+        for (size_t i = 0; i < cfg.models.size(); i++) {
+            const cyl_landmark_model &m = cfg.models[i];
+            std::string bands, hs;
+            for (int k = 0; k < m.n_bands; k++) {
+                bands += (k ? ", " : "") + std::string(m.band_cls[k] == CYL_BAND_GAP ? "gap" : table.name[m.band_cls[k]]);
+                std::snprintf(b, sizeof b, "%s%.6g", k ? ", " : "", m.band_height_m[k]);
+                hs += b;
+            }
+            s += "    - name: " + cfg.model_names[i] + "\n      bands: [" + bands + "]\n      band_heights_m: [" + hs + "]\n";
+            if (m.shape == CYL_SHAPE_CONE)
+                std::snprintf(b, sizeof b, "      shape: cone\n      diameter_m: [%.6g, %.6g]\n", m.diameter_bottom_m,
+                              m.diameter_top_m);
+            else
+                std::snprintf(b, sizeof b, "      diameter_m: %.6g\n", m.diameter_bottom_m);
+            s += b;
+            if (m.id >= 0) s += "      id: " + std::to_string(m.id) + "\n";
+        }
+    }
     return s;
 }
 

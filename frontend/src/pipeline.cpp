@@ -62,6 +62,15 @@ Detector::Detector(const cyl_colortable &table, const cyl_camera &camera, const 
     obs_.resize(config_.max_observations);
 }
 
+uint32_t model_classes(const DetectorConfig &cfg)
+{
+    uint32_t m = 0;
+    for (const cyl_landmark_model &md : cfg.models)
+        for (int k = 0; k < md.n_bands; k++)
+            if (md.band_cls[k] != CYL_BAND_GAP) m |= 1u << md.band_cls[k];
+    return m;
+}
+
 const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
 {
     cyl_status s = cyl_segment(&table_, &img, &config_.segment, &seg_);
@@ -74,12 +83,37 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
     size_t need = cyl_observe_work_size(&seg_, &config_.observe);
     if (obs_work_.size() < need) obs_work_.resize(need);  // grows to the largest frame seen, once
     obs_.resize(config_.max_observations);
-    uint32_t n = 0;
+    const uint32_t grouped = config_.models.empty() ? 0u : model_classes(config_);
+    const uint8_t mask_keep = config_.observe.class_mask;
+    config_.observe.class_mask = (uint8_t)(mask_keep & ~grouped);
+    uint32_t n = 0, n_single = 0;
     s = cyl_observe(&seg_, &camera_, &config_.observe, obs_work_.data(), obs_work_.size(), obs_.data(),
-                    (uint32_t)obs_.size(), &n);
-    config_.observe.image = nullptr;   // the frame is the caller's, valid during this call only
+                    (uint32_t)obs_.size(), &n_single);
+    config_.observe.class_mask = mask_keep;
+    if (s < 0) config_.observe.image = nullptr;
     check(s, "observation");
     truncated_ = truncated_ || s == CYL_TRUNCATED;
+    n = n_single;
+    if (grouped) {
+        const size_t gw = cyl_group_work_size(seg_.n_blobs, &config_.group);
+        if (group_work_.size() < gw) group_work_.resize(gw);
+        groups_.resize(seg_.n_blobs > 0 ? seg_.n_blobs : 1);
+        uint32_t ng = 0, no = 0;
+        s = cyl_group_blobs(&seg_, config_.models.data(), (uint32_t)config_.models.size(), &config_.group,
+                            group_work_.data(), group_work_.size(), groups_.data(), (uint32_t)groups_.size(), &ng);
+        if (s < 0) config_.observe.image = nullptr;
+        check(s, "grouping");
+        truncated_ = truncated_ || s == CYL_TRUNCATED;
+        groups_.resize(ng);
+        s = cyl_observe_groups(&seg_, groups_.data(), ng, config_.models.data(), (uint32_t)config_.models.size(),
+                               config_.plane_height_m, &camera_, &config_.observe, obs_work_.data(),
+                               obs_work_.size(), obs_.data() + n, (uint32_t)obs_.size() - n, &no);
+        if (s < 0) config_.observe.image = nullptr;
+        check(s, "observation of grouped landmarks");
+        truncated_ = truncated_ || s == CYL_TRUNCATED;
+        n += no;
+    }
+    config_.observe.image = nullptr;   // the frame is the caller's, valid during this call only
     obs_.resize(n);
     // clutter gates
     const bool masked = !config_.mask.empty();
@@ -88,19 +122,50 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
                     std::to_string(config_.mask_height) + " px but the frame is " + std::to_string(img.width) + "x" +
                     std::to_string(img.height) + " px");
     size_t k = 0;
+    boxes_.clear();
+    size_t gi = 0;
     for (size_t i = 0; i < obs_.size(); i++) {
         const cyl_observation &o = obs_[i];
         const cyl_blob &b = seg_.blobs[o.blob];
-        const ClassGate &g = config_.gate[o.cls];
-        bool keep = blob_passes(config_, b, img.width, img.height);
-        if (keep && g.size_gate > 0 && o.w_est_px > 0 && o.h_est_px > 0) {
-            const double f = g.size_gate;
-            const bool edge = (b.flags & CYL_BLOB_TOUCH_ANY) != 0;
-            if (o.w_px > f * o.w_est_px && o.h_px > f * o.h_est_px) keep = false;
-            if (!edge && o.w_px * f < o.w_est_px && o.h_px * f < o.h_est_px) keep = false;
+        std::array<uint16_t, 4> box{b.x0, b.y0, b.x1, b.y1};
+        bool keep;
+        if (o.model != CYL_NO_MODEL) {
+            // a grouped landmark: the groups were observed in order, each that gave an observation
+            while (gi < groups_.size() && groups_[gi].model != o.model) gi++;
+            while (gi < groups_.size()) {
+                bool member = false;
+                for (uint32_t bb : groups_[gi].blob) member = member || bb == o.blob;
+                if (member) break;
+                gi++;
+            }
+            if (gi < groups_.size()) {
+                const cyl_group &g = groups_[gi++];
+                box = {g.x0, g.y0, g.x1, g.y1};
+            }
+            // only the mask applies: the per-class gates judge one-colour blobs
+            keep = true;
+            if (masked) {
+                long x = std::lround(o.centroid_u_px), y = std::lround(o.centroid_v_px);
+                if (x >= 0 && y >= 0 && x < (long)img.width && y < (long)img.height &&
+                    config_.mask[(size_t)y * img.width + (size_t)x] == 0)
+                    keep = false;
+            }
+        } else {
+            const ClassGate &g = config_.gate[o.cls];
+            keep = blob_passes(config_, b, img.width, img.height);
+            if (keep && g.size_gate > 0 && o.w_est_px > 0 && o.h_est_px > 0) {
+                const double f = g.size_gate;
+                const bool edge = (b.flags & CYL_BLOB_TOUCH_ANY) != 0;
+                if (o.w_px > f * o.w_est_px && o.h_px > f * o.h_est_px) keep = false;
+                if (!edge && o.w_px * f < o.w_est_px && o.h_px * f < o.h_est_px) keep = false;
+            }
         }
-        if (keep) obs_[k++] = o;
-        else rejected_++;
+        if (keep) {
+            obs_[k++] = o;
+            boxes_.push_back(box);
+        } else {
+            rejected_++;
+        }
     }
     obs_.resize(k);
     return obs_;
@@ -187,7 +252,8 @@ std::string t_sec(int64_t t_ns)
 
 } // namespace
 
-ObservationLog::ObservationLog(const std::string &path, const Header &h) : path_(path), table_(h.table)
+ObservationLog::ObservationLog(const std::string &path, const Header &h)
+    : path_(path), table_(h.table), model_names_(h.model_names)
 {
     if (path == "-") {
         f_ = stdout;
@@ -205,6 +271,11 @@ ObservationLog::ObservationLog(const std::string &path, const Header &h) : path_
         line += str(h.table ? h.table->name[i] : "");
     }
     line += "]";
+    if (!h.model_names.empty()) {
+        line += ",\"landmark_models\":[";
+        for (size_t i = 0; i < h.model_names.size(); i++) line += (i ? "," : "") + str(h.model_names[i]);
+        line += "]";
+    }
     if (h.camera) {
         const cyl_camera &c = *h.camera;
         line += ",\"camera\":{\"width\":" + std::to_string(c.width) + ",\"height\":" + std::to_string(c.height) +
@@ -249,11 +320,12 @@ private:
 } // namespace
 
 void ObservationLog::frame(uint64_t seq, int64_t t_ns, const std::vector<cyl_observation> &obs,
-                           const cyl_segmentation *seg)
+                           const std::vector<std::array<uint16_t, 4>> *boxes)
 {
     const std::string t = t_sec(t_ns);
     write(JsonLine("frame").integer("seq", seq).raw("t", t).integer("n_obs", obs.size()).done());
-    for (const cyl_observation &o : obs) {
+    for (size_t i = 0; i < obs.size(); i++) {
+        const cyl_observation &o = obs[i];
         JsonLine l("obs");
         l.integer("seq", seq).raw("t", t).text("class", table_ ? table_->name[o.cls] : std::to_string(o.cls));
         l.integer("class_id", o.cls).num("range_m", o.range_m).num("bearing_rad", o.bearing_rad);
@@ -263,10 +335,16 @@ void ObservationLog::frame(uint64_t seq, int64_t t_ns, const std::vector<cyl_obs
         l.num("confidence", o.confidence).num("u_px", o.u_px).num("v_px", o.v_px);
         l.num("var_u_px2", o.var_u_px2).num("var_v_px2", o.var_v_px2);
         l.integer("area_px", o.area).integer("flags", o.flags);
-        if (seg && o.blob < seg->n_blobs) {
-            const cyl_blob &b = seg->blobs[o.blob];
-            l.raw("bbox_px", "[" + std::to_string(b.x0) + "," + std::to_string(b.y0) + "," + std::to_string(b.x1) + "," +
-                                 std::to_string(b.y1) + "]");
+        if (boxes && i < boxes->size()) {
+            const std::array<uint16_t, 4> &b = (*boxes)[i];
+            l.raw("bbox_px", "[" + std::to_string(b[0]) + "," + std::to_string(b[1]) + "," + std::to_string(b[2]) + "," +
+                                 std::to_string(b[3]) + "]");
+        }
+        if (o.model != CYL_NO_MODEL) {
+            l.text("landmark_model", o.model < model_names_.size() ? model_names_[o.model] : std::to_string(o.model));
+            if (o.landmark_id >= 0) l.integer("landmark_id", (uint64_t)o.landmark_id);
+            l.num("code_confidence", o.code_confidence).integer("group_flags", o.group_flags);
+            l.num("z_ref_m", o.z_ref_m);
         }
         std::string jm = "[", cf = "[";
         for (int a = 0; a < 2; a++)

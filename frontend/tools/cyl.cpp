@@ -361,8 +361,10 @@ int cmd_detect(const Args &a)
     // A class without a size gets confidence 0 on every observation, and a SLAM back end that
     // filters on confidence then uses none of them: say so. (A weak class, NAME~, makes no blobs of
     // its own: its pixels join its class's.)
+    // The classes of landmark models are observed as parts of their models (which have sizes).
+    const uint32_t grouped = model_classes(cfg);
     for (unsigned k = 0; k < CYL_MAX_CLASSES; k++)
-        if (table.name[k][0] && table.weak_of[k] == CYL_CLASS_NONE &&
+        if (table.name[k][0] && table.weak_of[k] == CYL_CLASS_NONE && !(grouped & (1u << k)) &&
             !(cfg.observe.size[k].diameter_m > 0 && cfg.observe.size[k].height_m > 0))
             std::fprintf(stderr, "cyl: warning: class '%s' has no landmark size (--size %s=D,H): its observations get "
                                  "confidence 0\n", table.name[k], table.name[k]);
@@ -382,6 +384,7 @@ int cmd_detect(const Args &a)
     hdr.estimator = estimator_name(est);
     hdr.table = &table;
     hdr.camera = &cam;
+    hdr.model_names = cfg.model_names;
     ObservationLog log(a.out, hdr);
 
     bool overlay_dir = false;
@@ -412,7 +415,7 @@ int cmd_detect(const Args &a)
         switch (ev.kind) {
         case RecordType::Frame: {
             const std::vector<cyl_observation> &obs = det.process(ev.image);
-            log.frame(ev.header.seq, ev.header.t_ns, obs, &det.segmentation());
+            log.frame(ev.header.seq, ev.header.t_ns, obs, &det.boxes());
             frames++;
             observations += obs.size();
             truncated += det.truncated();

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Source -> libcyl -> observations: the detector and the observation log (docs/formats.md).
 #pragma once
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <string>
@@ -12,6 +13,7 @@ extern "C" {
 #include "cyl/colortable.h"
 #include "cyl/segment.h"
 #include "cyl/observe.h"
+#include "cyl/landmark.h"
 }
 
 namespace cylfe {
@@ -39,7 +41,18 @@ struct DetectorConfig {
     uint32_t max_runs = 65536;   // run capacity per frame
     uint32_t max_blobs = 4096;   // blob capacity per frame
     uint32_t max_observations = 1024;
+    // Landmarks of several bands (the config's `landmarks:` section, cyl/landmark.h). When there
+    // are models, the blobs of their classes are grouped and observed as landmarks
+    // (cyl_observe_groups); the blobs of other classes are observed one by one as before.
+    std::vector<cyl_landmark_model> models;
+    std::vector<std::string> model_names;   // one per model
+    double plane_height_m = 0.0;            // height above the floor of the plane the camera's
+                                            // mount_height_m is counted from, m
+    cyl_group_params group = cyl_group_params_default();
 };
+
+// The classes some landmark model uses, as a bit mask (bit k: class k).
+uint32_t model_classes(const DetectorConfig &cfg);
 
 // The gates that need no camera (area, aspect, fill, mask) on one blob of a frame.
 bool blob_passes(const DetectorConfig &cfg, const cyl_blob &b, uint32_t frame_width, uint32_t frame_height);
@@ -74,6 +87,9 @@ public:
     const DetectorConfig &config() const { return config_; }
     bool truncated() const { return truncated_; }
     uint64_t rejected() const { return rejected_; }   // observations the gates dropped so far
+    // The box of each observation of the last frame (x0, y0, x1, y1, px inclusive): its blob's, or
+    // for a grouped landmark the union of its blobs'.
+    const std::vector<std::array<uint16_t, 4>> &boxes() const { return boxes_; }
 
 private:
     cyl_colortable table_;
@@ -82,6 +98,9 @@ private:
     std::vector<uint8_t> seg_mem_, obs_work_;
     cyl_segmentation seg_{};
     std::vector<cyl_observation> obs_;
+    std::vector<std::array<uint16_t, 4>> boxes_;
+    std::vector<uint8_t> group_work_;
+    std::vector<cyl_group> groups_;
     bool truncated_ = false;
     uint64_t rejected_ = 0;
 };
@@ -96,15 +115,16 @@ public:
         std::string source, model, estimator;
         const cyl_colortable *table = nullptr;
         const cyl_camera *camera = nullptr;
+        std::vector<std::string> model_names;   // the detector's landmark models, if any
     };
     ObservationLog(const std::string &path, const Header &header);
     ~ObservationLog();
     ObservationLog(const ObservationLog &) = delete;
     ObservationLog &operator=(const ObservationLog &) = delete;
 
-    // seg: the segmentation the observations came from (for their blobs' boxes), or null
+    // boxes: each observation's box (Detector::boxes()), or null
     void frame(uint64_t seq, int64_t t_ns, const std::vector<cyl_observation> &obs,
-               const cyl_segmentation *seg = nullptr);
+               const std::vector<std::array<uint16_t, 4>> *boxes = nullptr);
     void odometry(uint64_t seq, int64_t t_ns, const Odometry &o);
     void truth_pose(uint64_t seq, int64_t t_ns, const TruthPose &p);
     void truth_landmark(const TruthLandmark &l);
@@ -118,6 +138,7 @@ private:
     FILE *f_ = nullptr;
     bool is_stdout_ = false;
     const cyl_colortable *table_ = nullptr;
+    std::vector<std::string> model_names_;
     uint64_t lines_ = 0;
 };
 
