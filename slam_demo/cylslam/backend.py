@@ -198,7 +198,12 @@ class Slam:
         t0 = time.perf_counter()
         mode = p.assoc
         if mode == "auto":
-            mode = "known" if ds.known_ids else "unknown"
+            if ds.known_ids:
+                mode = "known"
+            elif any(o.lm_id is not None for st_ in ds.steps for o in st_.obs):
+                mode = "mixed"   # identities where the source read them, gating elsewhere
+            else:
+                mode = "unknown"
         if mode == "known" and not ds.known_ids:
             raise ValueError("known association requested but the observations carry no identities")
         steps = ds.steps
@@ -263,7 +268,8 @@ class Slam:
                     st["dropped_far"] += 1
                 else:
                     usable.append(o)
-            need = bool(usable) and mode == "unknown"
+            need = bool(usable) and (mode == "unknown" or
+                                     (mode == "mixed" and any(o.lm_id is None for o in usable)))
             if need or i - last_update >= p.update_every or i == n - 1:
                 isam.update(new_f, new_v)
                 st["isam_updates"] += 1
@@ -280,6 +286,17 @@ class Slam:
             if mode == "known":
                 # identities are given: no gating, and a landmark first seen creates it
                 targets = [id_to_lm.get(o.lm_id, -1) for o in usable]
+            elif mode == "mixed":
+                # an observation with an identity is associated by it; the others are gated
+                # against every landmark of their class, those made from identities included
+                targets = [id_to_lm.get(o.lm_id, -1) if o.lm_id is not None else None for o in usable]
+                rest = [k for k, o in enumerate(usable) if o.lm_id is None]
+                if rest:
+                    got = self._associate(isam, i, cur, [usable[k] for k in rest], [covs[k] for k in rest],
+                                          lms_init, lm_class, by_class, gate, new_thr, st)
+                    for k, t in zip(rest, got):
+                        targets[k] = t
+                st["by_identity"] = st.get("by_identity", 0) + len(usable) - len(rest)
             else:
                 targets = self._associate(isam, i, cur, usable, covs, lms_init, lm_class,
                                           by_class, gate, new_thr, st)
@@ -290,7 +307,7 @@ class Slam:
                 if j == -4:
                     st["dropped_imprecise"] += 1
                     continue
-                if mode == "known":
+                if mode == "known" or (mode == "mixed" and o.lm_id is not None):
                     j = id_to_lm.get(o.lm_id, -1)   # may have been created earlier this frame
                 if j == -1:
                     j = len(lms_init)
@@ -299,7 +316,7 @@ class Slam:
                     lm_class.append(o.cls)
                     lm_ids.append(o.lm_id)
                     by_class.setdefault(o.cls, []).append(j)
-                    if mode == "known":
+                    if o.lm_id is not None and mode in ("known", "mixed"):
                         id_to_lm[o.lm_id] = j
                     new_v.insert(L(j), gtsam.Point2(*pos))
                     st["new_landmarks"] += 1

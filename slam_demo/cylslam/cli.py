@@ -292,9 +292,10 @@ def last_line(s, extra=None):
 def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="grid",
                max_range_rel_sigma_default=0.0, reject_default="0x320"):
     g = sp.add_argument_group("back end")
-    g.add_argument("--assoc", choices=["auto", "known", "unknown"], default=assoc_default,
-                   help="data association: known identities, unknown (Mahalanobis gating), or "
-                        "auto = known when every observation carries an identity (default %(default)s)")
+    g.add_argument("--assoc", choices=["auto", "known", "unknown", "mixed"], default=assoc_default,
+                   help="data association: known identities, unknown (Mahalanobis gating), mixed "
+                        "(identities where observations carry one, gating elsewhere), or auto = known when "
+                        "every observation carries an identity, mixed when some do (default %(default)s)")
     g.add_argument("--conf-min", type=float, default=0.5,
                    help="drop observations with confidence below this (default %(default)s)")
     g.add_argument("--gate", type=float, default=0.99,

@@ -149,3 +149,31 @@ def test_gate_separates_a_new_landmark_from_a_known_one():
     assert [j for (_, _, j) in res.assoc] == [0, 1]
     assert metrics.evaluate(ds, res)["association_errors"] == 0
     assert backend.chi2_2dof(0.99) == pytest.approx(9.2103, abs=1e-4)
+
+
+def test_mixed_association_uses_identities_where_given():
+    """The scene of test_association_errors_are_counted, whose generous gate puts B's observation
+    on A: with identities on A's and B's observations (a code read), B becomes its own landmark;
+    an observation without an identity, near A, is gated onto the landmark A's identity made."""
+    A, B = np.array([3.0, 0.3]), np.array([3.0, -0.3])
+    cov = np.diag([0.05 ** 2, 0.05 ** 2])
+    p0 = np.zeros(3)
+    p1 = np.array([0.1, 0.0, 0.0])
+    a0 = _obs("orange", p0, A, cov)
+    a0.lm_id = 10
+    b1 = _obs("orange", p1, B, cov)
+    b1.lm_id = 11
+    a1 = _obs("orange", p1, A + np.array([0.01, 0.0]), cov)   # no identity
+    s0 = Step(t=0, seq=0, truth=p0, obs=[a0])
+    s1 = Step(t=1, seq=1, odom=p1.copy(), odom_cov=np.diag([1e-4] * 3), truth=p1, obs=[b1, a1])
+    ds = Dataset(name="mixed", steps=[s0, s1], truth_landmarks={0: (*A, "orange"), 1: (*B, "orange")})
+    res = backend.Slam(backend.Params(assoc="auto", gate_p=0.999999, new_p=0.9999999)).run(ds)
+    assert res.stats["association"] == "mixed"
+    assert res.stats["by_identity"] == 2
+    assert [j for (_, _, j) in res.assoc] == [0, 1, 0]
+    assert metrics.evaluate(ds, res)["association_errors"] == 0
+    # the same log without the identities: the gate takes B's observation for A
+    b1.lm_id = a0.lm_id = None
+    res = backend.Slam(backend.Params(assoc="auto", gate_p=0.999999, new_p=0.9999999)).run(ds)
+    assert res.stats["association"] == "unknown"
+    assert [j for (_, _, j) in res.assoc][:2] == [0, 0]
