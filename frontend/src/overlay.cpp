@@ -120,8 +120,14 @@ void draw_overlay(cv::Mat &bgr, const Detector &det, const std::vector<cyl_obser
     const cyl_segmentation &seg = det.segmentation();
     const cyl_colortable &t = det.table();
     std::vector<int> obs_of_blob(seg.n_blobs, -1);
-    for (size_t i = 0; i < obs.size(); i++)
+    // the detector's own observations carry their blobs (several for a grouped landmark)
+    const bool own = &obs == &det.last_observations() && det.members().size() == obs.size();
+    for (size_t i = 0; i < obs.size(); i++) {
         if (obs[i].blob < seg.n_blobs) obs_of_blob[obs[i].blob] = (int)i;
+        if (own)
+            for (uint32_t m : det.members()[i])
+                if (m < seg.n_blobs) obs_of_blob[m] = (int)i;
+    }
     const cv::Scalar grey(150, 150, 150);
     // Rejected blobs first, so that landmarks are drawn over them.
     for (uint32_t i = 0; i < seg.n_blobs; i++) {
@@ -148,24 +154,42 @@ void draw_overlay(cv::Mat &bgr, const Detector &det, const std::vector<cyl_obser
     }
     // Low-confidence observations, then landmarks (on top, with labels and ellipses).
     for (int pass = 0; pass < 2; pass++)
-        for (const cyl_observation &o : obs) {
+        for (size_t i = 0; i < obs.size(); i++) {
+            const cyl_observation &o = obs[i];
             if (o.blob >= seg.n_blobs) continue;
             const OverlayKind kind = overlay_kind(o, opt);
             if ((pass == 0) != (kind == OverlayKind::LowConfidence)) continue;
             const cyl_blob &b = seg.blobs[o.blob];
             cv::Vec3b col(t.rgb[o.cls][2], t.rgb[o.cls][1], t.rgb[o.cls][0]);
             const cv::Scalar colour(col[0], col[1], col[2]);
-            tint_blob(bgr, seg, b, col);
+            // a grouped landmark: every band's blob in its own class colour, the union box
+            cv::Point p0(b.x0, b.y0), p1(b.x1, b.y1);
+            if (own && o.model != CYL_NO_MODEL) {
+                for (uint32_t m : det.members()[i]) {
+                    if (m >= seg.n_blobs) continue;
+                    const uint8_t c = seg.blobs[m].cls;
+                    tint_blob(bgr, seg, seg.blobs[m], cv::Vec3b(t.rgb[c][2], t.rgb[c][1], t.rgb[c][0]));
+                }
+                const std::array<uint16_t, 4> &bx = det.boxes()[i];
+                p0 = cv::Point(bx[0], bx[1]);
+                p1 = cv::Point(bx[2], bx[3]);
+            } else {
+                tint_blob(bgr, seg, b, col);
+            }
             if (kind == OverlayKind::LowConfidence) {
-                cv::rectangle(bgr, cv::Point(b.x0, b.y0), cv::Point(b.x1, b.y1), colour, 1);
+                cv::rectangle(bgr, p0, p1, colour, 1);
                 continue;
             }
-            cv::rectangle(bgr, cv::Point(b.x0, b.y0), cv::Point(b.x1, b.y1), colour, 2);
+            cv::rectangle(bgr, p0, p1, colour, 2);
             cv::circle(bgr, cv::Point((int)std::lround(o.u_px), (int)std::lround(o.v_px)), 2, cv::Scalar(255, 255, 255), -1);
-            char text[96];
-            std::snprintf(text, sizeof text, "%s %.2fm %.1fdeg c%.2f", t.name[o.cls], o.range_m,
+            char text[128];
+            std::string name = t.name[o.cls];
+            const std::vector<std::string> &models = det.config().model_names;
+            if (o.model != CYL_NO_MODEL) name = o.model < models.size() ? models[o.model] : std::to_string(o.model);
+            if (o.landmark_id >= 0) name += " #" + std::to_string(o.landmark_id);
+            std::snprintf(text, sizeof text, "%s %.2fm %.1fdeg c%.2f", name.c_str(), o.range_m,
                           o.bearing_rad * 180 / M_PI, o.confidence);
-            label(bgr, taken, text, cv::Point(b.x0, b.y0 - 1), 0.4);
+            label(bgr, taken, text, cv::Point(p0.x, p0.y - 1), 0.4);
             std::vector<cv::Point> poly = overlay_ellipse(det.camera(), o, opt, bgr.size());
             if (poly.size() > 2) cv::polylines(bgr, poly, true, cv::Scalar(0, 255, 255), 1, cv::LINE_AA);
         }

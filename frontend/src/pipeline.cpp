@@ -123,11 +123,15 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
                     std::to_string(img.height) + " px");
     size_t k = 0;
     boxes_.clear();
+    members_.clear();
     size_t gi = 0;
     for (size_t i = 0; i < obs_.size(); i++) {
         const cyl_observation &o = obs_[i];
         const cyl_blob &b = seg_.blobs[o.blob];
         std::array<uint16_t, 4> box{b.x0, b.y0, b.x1, b.y1};
+        std::array<uint32_t, CYL_MODEL_MAX_BANDS> members;
+        members.fill(CYL_NONE);
+        members[0] = o.blob;
         bool keep;
         if (o.model != CYL_NO_MODEL) {
             // a grouped landmark: the groups were observed in order, each that gave an observation
@@ -141,6 +145,7 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
             if (gi < groups_.size()) {
                 const cyl_group &g = groups_[gi++];
                 box = {g.x0, g.y0, g.x1, g.y1};
+                std::copy(g.blob, g.blob + CYL_MODEL_MAX_BANDS, members.begin());
             }
             // only the mask applies: the per-class gates judge one-colour blobs
             keep = true;
@@ -163,6 +168,7 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
         if (keep) {
             obs_[k++] = o;
             boxes_.push_back(box);
+            members_.push_back(members);
         } else {
             rejected_++;
         }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cylfe/error.hpp"
+#include "cylfe/overlay.hpp"
 #include "cylfe/pipeline.hpp"
 
 using namespace cylfe;
@@ -68,6 +69,13 @@ std::string error_of(const std::string &text)
     }
     std::remove(p.c_str());
     return msg;
+}
+
+int seg_blob_at(const cyl_segmentation &seg, int x, int y)
+{
+    for (uint32_t i = 0; i < seg.n_blobs; i++)
+        if (x >= seg.blobs[i].x0 && x <= seg.blobs[i].x1 && y >= seg.blobs[i].y0 && y <= seg.blobs[i].y1) return (int)i;
+    return -1;
 }
 
 } // namespace
@@ -194,4 +202,18 @@ TEST(LandmarkConfig, DetectorObservesTheGroup)
     EXPECT_EQ(obs[1].group_flags, (uint32_t)CYL_GROUP_MISSING_BAND);
     EXPECT_DOUBLE_EQ(obs[1].code_confidence, 0.5);
     EXPECT_EQ(det.boxes()[1], (std::array<uint16_t, 4>{40, 40, 59, 59}));
+    ASSERT_EQ(det.members().size(), 2u);
+    EXPECT_EQ(det.members()[0][0], (uint32_t)seg_blob_at(det.segmentation(), 155, 155));
+    EXPECT_EQ(det.members()[0][1], (uint32_t)seg_blob_at(det.segmentation(), 155, 175));
+    // the overlay: the green band tinted green (not grey, as a rejected blob would be), the union
+    // box in the landmark's colour (its first band's, pink) at the top-left corner of the pink band
+    cv::Mat bgr = to_bgr(img);
+    OverlayOptions opt;
+    opt.min_confidence = 0.0;
+    opt.key = false;
+    draw_overlay(bgr, det, obs, opt);
+    const cv::Vec3b g = bgr.at<cv::Vec3b>(180, 160), corner = bgr.at<cv::Vec3b>(150, 150);
+    EXPECT_GT(g[1], g[0] + 40);
+    EXPECT_GT(g[1], g[2] + 40);
+    EXPECT_EQ(corner, cv::Vec3b(255, 0, 255));
 }

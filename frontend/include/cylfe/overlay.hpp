@@ -9,6 +9,8 @@
 //                   pixels and a 1 px box in the class colour, no label;
 //   rejected blob   a blob the detector's gates dropped (area, shape, size, ROI): pixels in grey,
 //                   a thin grey box, no label.
+// A landmark of several bands (a grouped observation) has each band's pixels in its own class
+// colour, the box around all of them, and a label naming its model and identity ("post7 #7").
 // Labels that would overlap an earlier one move down, and are left out when there is no room.
 // A key in the top-left corner names the three kinds.
 #pragma once

@@ -81,6 +81,7 @@ public:
     // Process one frame. Throws Error on invalid frames; capacity truncation is reported by
     // truncated(). The returned vector is valid until the next call.
     const std::vector<cyl_observation> &process(const cyl_image &img);
+    const std::vector<cyl_observation> &last_observations() const { return obs_; }
     const cyl_segmentation &segmentation() const { return seg_; }
     const cyl_colortable &table() const { return table_; }
     const cyl_camera &camera() const { return camera_; }
@@ -90,6 +91,9 @@ public:
     // The box of each observation of the last frame (x0, y0, x1, y1, px inclusive): its blob's, or
     // for a grouped landmark the union of its blobs'.
     const std::vector<std::array<uint16_t, 4>> &boxes() const { return boxes_; }
+    // The blobs of each observation of the last frame (indices in segmentation().blobs, CYL_NONE
+    // for none): its blob, or a grouped landmark's blobs band by band.
+    const std::vector<std::array<uint32_t, CYL_MODEL_MAX_BANDS>> &members() const { return members_; }
 
 private:
     cyl_colortable table_;
@@ -99,6 +103,7 @@ private:
     cyl_segmentation seg_{};
     std::vector<cyl_observation> obs_;
     std::vector<std::array<uint16_t, 4>> boxes_;
+    std::vector<std::array<uint32_t, CYL_MODEL_MAX_BANDS>> members_;
     std::vector<uint8_t> group_work_;
     std::vector<cyl_group> groups_;
     bool truncated_ = false;
