@@ -6,8 +6,11 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "cylfe/error.hpp"
 #include "cylfe/rawlog.hpp"
@@ -342,6 +345,347 @@ TEST(SynthScene, FileRoundTripAndErrors)
         EXPECT_NE(std::string(e.what()).find(path), std::string::npos);
     }
     remove(path);
+}
+
+// ---- landmarks of several colours and cones ---------------------------------------------------
+
+namespace {
+
+// The classes and colours of multiband_scene(), from the scene itself.
+Band band_of(const Scene &mb, double h, int32_t cls)
+{
+    for (const Cylinder &c : mb.cylinders)
+        for (const Band &b : c.bands)
+            if (b.cls == cls) { Band r = b; r.height_m = h; return r; }
+    ADD_FAILURE() << "no band of class " << cls;
+    return Band{};
+}
+
+// The expected clean-frame colour of a surface of colour c with outward normal n under the scene's
+// shading at unit gain (Renderer: shade = ambient + diffuse max(0, n . l), chroma offsets scaled).
+Yuv shaded(const Imaging &im, const Yuv &c, const double n[3])
+{
+    const double L[3] = {std::cos(im.light_el_rad) * std::cos(im.light_az_rad),
+                         std::cos(im.light_el_rad) * std::sin(im.light_az_rad), std::sin(im.light_el_rad)};
+    double g = im.ambient + im.diffuse * std::max(0.0, n[0] * L[0] + n[1] * L[1] + n[2] * L[2]);
+    return Yuv{c.y * g, 128 + (c.u - 128) * g, 128 + (c.v - 128) * g};
+}
+
+} // namespace
+
+// At the image row of the middle of each band (the point of the band's middle height on the side
+// facing the camera, projected with the scene camera), the clean frame has that band's colour, as
+// shaded with the surface's normal (a cone's tilted up); the pixels are labelled with the landmark.
+TEST(SynthRender, BandColoursAtBandMiddles)
+{
+    const Scene mb = multiband_scene();
+    Scene s = quiet_scene();
+    s.classes = mb.classes;
+    s.imaging.light_az_rad = 3.4;  // light from behind the camera: the sides in view are lit and a
+                                   // cone's normal (tilted up) shades differently from a cylinder's
+    Cylinder coded;  // green / blue / pink, 0.10 m each
+    coded.id = 0; coded.cls = 1; coded.x_m = 1.6; coded.y_m = 0.05;
+    coded.diameter_m = 0.10; coded.height_m = 0.30;
+    coded.bands = {band_of(mb, 0.10, 1), band_of(mb, 0.10, 2), band_of(mb, 0.10, 3)};
+    coded.colour = coded.bands[0].colour;
+    Cylinder cone;   // orange / white / orange, 0.10 / 0.05 / 0.15 m
+    cone.id = 1; cone.cls = 0; cone.x_m = 1.5; cone.y_m = -0.1;
+    cone.diameter_m = 0.25; cone.diameter_top_m = 0.05; cone.height_m = 0.30;
+    cone.bands = {band_of(mb, 0.10, 0), band_of(mb, 0.05, -1), band_of(mb, 0.15, 0)};
+    cone.colour = cone.bands[0].colour;
+    ASSERT_NEAR(cone.bands[1].colour.y, 200, 1) << "the cone's stripe: white";
+    const Pose2 robot{0, 0, 0.02};
+    int checked = 0;
+    for (const Cylinder &c : {coded, cone}) {
+        Renderer ren(s);
+        ren.mutable_scene().cylinders.assign(1, c);
+        CleanFrame cf;
+        cf.want_labels = true;
+        ren.render_clean(robot, 1.0, cf);
+        CameraPose cp = camera_pose(s.camera, robot);
+        double ex = cp.c[0] - c.x_m, ey = cp.c[1] - c.y_m, el = std::hypot(ex, ey);
+        ex /= el; ey /= el;  // horizontal unit vector from the axis towards the camera
+        const double R0 = c.diameter_m / 2;
+        const double R1 = c.diameter_top_m >= 0 ? c.diameter_top_m / 2 : R0;
+        const double k = (R1 - R0) / c.height_m;
+        double top = c.height_m;
+        Yuv prev{-1000, -1000, -1000};
+        for (const Band &b : c.bands) {
+            double zm = top - b.height_m / 2;
+            top -= b.height_m;
+            double R = R0 + k * zm;
+            double p[3] = {c.x_m + R * ex, c.y_m + R * ey, zm}, u, v;
+            ASSERT_TRUE(project_point(s.camera, cp, p, &u, &v));
+            int px = (int)std::lround(u), py = (int)std::lround(v);
+            ASSERT_TRUE(px >= 0 && px < 640 && py >= 0 && py < 480);
+            double nn = std::sqrt(1 + k * k), n[3] = {ex / nn, ey / nn, -k / nn};
+            Yuv want = shaded(s.imaging, b.colour, n);
+            size_t i = (size_t)py * 640 + px;
+            EXPECT_NEAR(cf.y[i], want.y, 1.0) << "band at z " << zm << " of landmark " << c.id;
+            EXPECT_NEAR(cf.u[i], want.u, 1.0) << "band at z " << zm << " of landmark " << c.id;
+            EXPECT_NEAR(cf.v[i], want.v, 1.0) << "band at z " << zm << " of landmark " << c.id;
+            EXPECT_EQ(cf.label[i], 0) << "every band is the landmark's";
+            // neighbouring bands really differ (the test would not see a wrong band otherwise)
+            EXPECT_GT(std::fabs(want.y - prev.y) + std::fabs(want.u - prev.u) + std::fabs(want.v - prev.v), 40.0);
+            prev = want;
+            checked++;
+        }
+    }
+    EXPECT_EQ(checked, 6);
+}
+
+// The silhouette width of a cone at two heights against the pinhole projection (derived here, not
+// with the renderer's code) of its horizontal diameter at that height, across the line of sight.
+// Distortion, blur and directional light off: a pixel's Y is the cone's or the floor's in
+// proportion to its coverage, so a row's width is measured to a fraction of a pixel.
+TEST(SynthRender, ConeSilhouetteWidthMatchesProjection)
+{
+    Scene s = quiet_scene();
+    CameraModel &cam = s.camera;
+    cam.k1 = cam.k2 = cam.p1 = cam.p2 = cam.k3 = 0;
+    s.imaging.blur_sigma_px = 0;
+    s.imaging.chroma_blur_px = 0;
+    s.imaging.samples = 4;
+    s.imaging.ambient = 1.0;
+    s.imaging.diffuse = 0.0;
+    s.room.floor_texture = 0;
+    Cylinder cone;
+    cone.cls = 0; cone.diameter_m = 0.25; cone.diameter_top_m = 0.05; cone.height_m = 0.30;
+    cone.colour = Yuv{40, 128, 128};
+    Renderer ren(s);
+    const double Yb = s.room.floor.y, Yc = cone.colour.y;
+    const Pose2 robot{0, 0, 0};
+    // pinhole camera of the test's own: centre, axes right, down, forward
+    const double psi = robot.theta + cam.yaw_rad, tl = cam.tilt_rad;
+    const double C[3] = {robot.x + cam.offset_m * std::cos(robot.theta), robot.y + cam.offset_m * std::sin(robot.theta),
+                         cam.height_floor_m};
+    const double F[3] = {std::cos(tl) * std::cos(psi), std::cos(tl) * std::sin(psi), -std::sin(tl)};
+    const double Rt[3] = {std::sin(psi), -std::cos(psi), 0};
+    const double Dn[3] = {F[1] * Rt[2] - F[2] * Rt[1], F[2] * Rt[0] - F[0] * Rt[2], F[0] * Rt[1] - F[1] * Rt[0]};
+    auto pinhole = [&](const double P[3], double *u, double *v) {
+        double q[3] = {P[0] - C[0], P[1] - C[1], P[2] - C[2]};
+        double zc = q[0] * F[0] + q[1] * F[1] + q[2] * F[2];
+        *u = cam.cx + cam.fx * (q[0] * Rt[0] + q[1] * Rt[1] + q[2] * Rt[2]) / zc;
+        *v = cam.cy + cam.fy * (q[0] * Dn[0] + q[1] * Dn[1] + q[2] * Dn[2]) / zc;
+    };
+    const double places[][2] = {{1.6, 0.0}, {2.3, 0.45}};
+    int checked = 0;
+    for (const auto &pl : places) {
+        cone.x_m = pl[0];
+        cone.y_m = pl[1];
+        ren.mutable_scene().cylinders.assign(1, cone);
+        CleanFrame cf;
+        ren.render_clean(robot, 1.0, cf);
+        double ex = cone.x_m - C[0], ey = cone.y_m - C[1], el = std::hypot(ex, ey);
+        const double px_dir[2] = {-ey / el, ex / el};  // horizontal, across the line of sight
+        for (double z : {0.07, 0.22}) {
+            double R = cone.diameter_m / 2 + (cone.diameter_top_m - cone.diameter_m) / 2 * z / cone.height_m;
+            double P1[3] = {cone.x_m - R * px_dir[0], cone.y_m - R * px_dir[1], z};
+            double P2[3] = {cone.x_m + R * px_dir[0], cone.y_m + R * px_dir[1], z};
+            double u1, v1, u2, v2;
+            pinhole(P1, &u1, &v1);
+            pinhole(P2, &u2, &v2);
+            const double want = std::fabs(u2 - u1), vrow = 0.5 * (v1 + v2), uc = 0.5 * (u1 + u2);
+            // measured width at the rows either side of vrow (pixel centres at integers), interpolated
+            auto width_at = [&](int py) {
+                int x0 = (int)std::floor(uc - want / 2 - 8), x1 = (int)std::ceil(uc + want / 2 + 8);
+                EXPECT_TRUE(x0 >= 0 && x1 < 640);
+                const float *row = &cf.y[(size_t)py * 640];
+                EXPECT_NEAR(row[x0], Yb, 1e-3) << "floor left of the cone";
+                EXPECT_NEAR(row[x1], Yb, 1e-3) << "floor right of the cone";
+                double w = 0;
+                for (int x = x0; x <= x1; x++) w += (Yb - row[x]) / (Yb - Yc);
+                return w;
+            };
+            int r0 = (int)std::floor(vrow);
+            double f = vrow - r0;
+            double got = (1 - f) * width_at(r0) + f * width_at(r0 + 1);
+            EXPECT_NEAR(got, want, 1.5) << "cone at " << pl[0] << "," << pl[1] << ", z " << z << " (row " << vrow << ")";
+            EXPECT_GT(want, 15.0);
+            checked++;
+        }
+    }
+    EXPECT_EQ(checked, 4);
+}
+
+// A landmark without bands renders as before: bit for bit like one band of its own colour, and a
+// "cone" whose top diameter equals its base diameter like the cylinder.
+TEST(SynthRender, UnbandedCylinderUnchanged)
+{
+    Scene s = quiet_scene();
+    s.imaging.noise_y = 2.5;  // the clean frame has no noise anyway
+    Scene d = default_scene();
+    s.classes = d.classes;
+    s.cylinders.push_back(d.cylinders[0]);
+    s.cylinders.back().x_m = 1.5; s.cylinders.back().y_m = 0.02;
+    s.cylinders.push_back(d.cylinders[7]);
+    s.cylinders.back().x_m = 2.2; s.cylinders.back().y_m = -0.5;
+    Scene banded = s, same_top = s;
+    for (Cylinder &c : banded.cylinders) c.bands = {Band{c.height_m, c.cls, c.colour}};
+    for (Cylinder &c : same_top.cylinders) c.diameter_top_m = c.diameter_m;
+    const Pose2 robot{0.1, -0.05, 0.05};
+    CleanFrame a, b, c;
+    a.want_labels = b.want_labels = c.want_labels = true;
+    Renderer(s).render_clean(robot, 1.0, a);
+    Renderer(banded).render_clean(robot, 1.0, b);
+    Renderer(same_top).render_clean(robot, 1.0, c);
+    size_t lm_px = 0;
+    for (int32_t l : a.label) lm_px += l >= 0;
+    EXPECT_GT(lm_px, 1000u) << "both landmarks in view";
+    EXPECT_TRUE(a.y == b.y && a.u == b.u && a.v == b.v && a.label == b.label) << "one band of the same colour";
+    EXPECT_TRUE(a.y == c.y && a.u == c.u && a.v == c.v && a.label == c.label) << "diameter_top_m = diameter_m";
+}
+
+TEST(SynthScene, BandsAndConeFileRoundTripAndErrors)
+{
+    Scene s = multiband_scene();
+    s.cylinders[0].bands[1].colour = Yuv{201.25, 127.5, 128.75};  // values that need their digits
+    s.cylinders[1].diameter_top_m = 0.0;                          // a full cone
+    for (const char *path : {"/tmp/cyl_synth_bands_test.yaml", "/tmp/cyl_synth_bands_test.json"}) {
+        save_scene(path, s);
+        Scene r = load_scene(path);
+        EXPECT_EQ(r.classes, s.classes);
+        ASSERT_EQ(r.cylinders.size(), s.cylinders.size()) << path;
+        for (size_t i = 0; i < s.cylinders.size(); i++) {
+            const Cylinder &a = s.cylinders[i], &b = r.cylinders[i];
+            EXPECT_EQ(b.id, a.id);
+            EXPECT_EQ(b.cls, a.cls);
+            EXPECT_EQ(b.diameter_m, a.diameter_m);
+            EXPECT_EQ(b.diameter_top_m, a.diameter_top_m) << path << " cylinder " << i;
+            EXPECT_EQ(b.height_m, a.height_m);
+            ASSERT_EQ(b.bands.size(), a.bands.size()) << path << " cylinder " << i;
+            for (size_t j = 0; j < a.bands.size(); j++) {
+                EXPECT_EQ(b.bands[j].height_m, a.bands[j].height_m);
+                EXPECT_EQ(b.bands[j].cls, a.bands[j].cls);
+                EXPECT_EQ(b.bands[j].colour.y, a.bands[j].colour.y);
+                EXPECT_EQ(b.bands[j].colour.u, a.bands[j].colour.u);
+                EXPECT_EQ(b.bands[j].colour.v, a.bands[j].colour.v);
+            }
+        }
+        // the same clean frame from the loaded scene
+        CleanFrame fa, fb;
+        const Pose2 robot{-0.2, 1.1, 1.9};
+        Renderer(s).render_clean(robot, 1.0, fa);
+        Renderer(r).render_clean(robot, 1.0, fb);
+        EXPECT_TRUE(fa.y == fb.y && fa.u == fb.u && fa.v == fb.v) << path;
+        remove(path);
+    }
+    // a scene without bands or cones writes neither field
+    {
+        const char *path = "/tmp/cyl_synth_bands_test_plain.yaml";
+        save_scene(path, default_scene());
+        FILE *f = fopen(path, "r");
+        ASSERT_TRUE(f);
+        std::string text;
+        char buf[4096];
+        size_t n;
+        while ((n = fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+        fclose(f);
+        EXPECT_EQ(text.find("bands"), std::string::npos);
+        EXPECT_EQ(text.find("diameter_top_m"), std::string::npos);
+        remove(path);
+    }
+    const char *path = "/tmp/cyl_synth_bands_test_bad.yaml";
+    auto expect_error = [&](const char *yaml, std::vector<std::string> parts) {
+        FILE *f = fopen(path, "w");
+        ASSERT_TRUE(f);
+        fputs(yaml, f);
+        fclose(f);
+        try {
+            load_scene(path);
+            ADD_FAILURE() << "accepted:\n" << yaml;
+        } catch (const Error &e) {
+            parts.push_back(path);
+            for (const std::string &p : parts)
+                EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << "'" << p << "' not in: " << e.what();
+        }
+    };
+    // band heights 0.10 + 0.15 for a cylinder 0.30 m tall
+    expect_error("%YAML:1.0\n---\nclasses: [red, blue]\ncylinders:\n"
+                 "  - { class: red, x_m: 1.0, y_m: 0, height_m: 0.3 }\n"
+                 "  - { class: red, x_m: 2.0, y_m: 0, height_m: 0.3,\n"
+                 "      bands: [ { height_m: 0.10, class: red, colour: [80, 90, 200] },\n"
+                 "               { height_m: 0.15, class: blue, colour: [80, 200, 90] } ] }\n",
+                 {"cylinders[1].bands", "height_m", "0.25", "0.3"});
+    // a misspelt key in a band
+    expect_error("%YAML:1.0\n---\nclasses: [red, blue]\ncylinders:\n"
+                 "  - { class: red, x_m: 2.0, y_m: 0, height_m: 0.3,\n"
+                 "      bands: [ { height_m: 0.15, class: red, colour: [80, 90, 200] },\n"
+                 "               { height_m: 0.15, class: blue, colur: [80, 200, 90] } ] }\n",
+                 {"cylinders[0].bands[1]", "colur", "colour"});
+    // an unknown class in a band
+    expect_error("%YAML:1.0\n---\nclasses: [red, blue]\ncylinders:\n"
+                 "  - { class: red, x_m: 2.0, y_m: 0, height_m: 0.3,\n"
+                 "      bands: [ { height_m: 0.3, class: green, colour: [80, 90, 200] } ] }\n",
+                 {"green"});
+    // a band without its height
+    expect_error("%YAML:1.0\n---\nclasses: [red, blue]\ncylinders:\n"
+                 "  - { class: red, x_m: 2.0, y_m: 0, height_m: 0.3,\n"
+                 "      bands: [ { class: red, colour: [80, 90, 200] } ] }\n",
+                 {"cylinders[0].bands[0].height_m"});
+    remove(path);
+}
+
+// The built-in "multiband" scene: 6 striped cones and 8 coded cylinders with distinct codes, apart
+// from each other and from the drive, in the default room.
+TEST(SynthScene, MultibandScene)
+{
+    Scene s = scene_by_name("multiband");
+    EXPECT_EQ(s.name, "multiband");
+    ASSERT_EQ(s.classes, (std::vector<std::string>{"orange", "green", "blue", "pink"}));
+    EXPECT_EQ(s.landmark_diameter_m, 0.10);
+    EXPECT_EQ(s.landmark_height_m, 0.30);
+    int cones = 0, coded = 0;
+    std::vector<std::vector<int32_t>> codes;
+    std::vector<const Cylinder *> lms;
+    for (const Cylinder &c : s.cylinders) {
+        if (!c.landmark) continue;
+        lms.push_back(&c);
+        double sum = 0;
+        for (const Band &b : c.bands) sum += b.height_m;
+        EXPECT_NEAR(sum, c.height_m, 1e-9);
+        ASSERT_FALSE(c.bands.empty());
+        EXPECT_EQ(c.cls, c.bands[0].cls);
+        if (c.diameter_top_m >= 0) {
+            cones++;
+            EXPECT_EQ(c.diameter_m, 0.25);
+            EXPECT_EQ(c.diameter_top_m, 0.05);
+            ASSERT_EQ(c.bands.size(), 3u);
+            EXPECT_EQ(c.bands[0].cls, 0);
+            EXPECT_EQ(c.bands[1].cls, -1);
+            EXPECT_EQ(c.bands[2].cls, 0);
+        } else {
+            coded++;
+            EXPECT_EQ(c.diameter_m, 0.10);
+            std::vector<int32_t> code;
+            for (size_t j = 0; j < c.bands.size(); j++) {
+                EXPECT_GE(c.bands[j].cls, 1);
+                if (j) {
+                    EXPECT_NE(c.bands[j].cls, c.bands[j - 1].cls) << "neighbouring bands alike";
+                }
+                code.push_back(c.bands[j].cls);
+            }
+            codes.push_back(code);
+        }
+    }
+    EXPECT_EQ(cones, 6);
+    EXPECT_EQ(coded, 8);
+    // no code is a contiguous part of another (or equal to it)
+    for (size_t i = 0; i < codes.size(); i++)
+        for (size_t j = 0; j < codes.size(); j++) {
+            if (i == j || codes[i].size() > codes[j].size()) continue;
+            EXPECT_EQ(std::search(codes[j].begin(), codes[j].end(), codes[i].begin(), codes[i].end()), codes[j].end())
+                << "code " << i << " within code " << j;
+        }
+    for (size_t i = 0; i < lms.size(); i++)
+        for (size_t j = i + 1; j < lms.size(); j++)
+            EXPECT_GE(std::hypot(lms[i]->x_m - lms[j]->x_m, lms[i]->y_m - lms[j]->y_m), 0.6);
+    // off the drive: the robot's centre passes every landmark's axis at 0.5 m or more
+    for (double d = 0; d < 40; d += 0.02) {
+        Pose2 p = trajectory_pose(s.trajectory, d);
+        for (const Cylinder *c : lms) EXPECT_GE(std::hypot(p.x - c->x_m, p.y - c->y_m), 0.5) << "landmark " << c->id;
+    }
+    EXPECT_EQ(s.boxes.size(), 2u);
 }
 
 TEST(SynthRawLog, RoundTrip)

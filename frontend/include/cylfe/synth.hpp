@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // cylfe::synth -- a synthetic camera with ground truth (docs/synthetic.md).
 //
-// A flat floor inside a room of walls; vertical cylinders (the landmarks), boxes, thin poles
-// and floor patches (clutter in landmark colours, neutral occluders); a robot with a camera
-// mounted on it, driving a trajectory with noisy odometry. Frames are rendered by casting rays
+// A flat floor inside a room of walls; vertical cylinders or truncated cones, in one colour or in
+// horizontal bands of colour (the landmarks), boxes, thin poles and floor patches (clutter in
+// landmark colours, neutral occluders); a robot with a camera mounted on it, driving a
+// trajectory with noisy odometry. Frames are rendered by casting rays
 // through sub-pixel samples of every pixel (supersampling = anti-aliased edges) through this
 // file's own lens model and mounting -- independent of libcyl's camera code -- then optical
 // blur, exposure, per-pixel sensor noise in YUV, 4:2:2 chroma subsampling into YUYV bytes.
@@ -38,13 +39,30 @@ struct Yuv {
     double y = 128, u = 128, v = 128;
 };
 
+// One horizontal colour band of a landmark (Cylinder::bands).
+struct Band {
+    double height_m = 0.1;         // > 0
+    int32_t cls = -1;              // colour class index, -1 = a colour no class stands for (a cone's
+                                   // white stripe)
+    Yuv colour;
+};
+
 struct Cylinder {                  // vertical, standing on the floor, closed top
     uint32_t id = 0;               // landmark id (TruthLandmark id), unique
-    int32_t cls = -1;              // colour class index (names in Scene::classes), -1 = none
+    int32_t cls = -1;              // colour class index (names in Scene::classes), -1 = none; with
+                                   // bands: the class the truth reports (multiband_scene: the top band's)
     bool landmark = true;          // false: clutter (a thin pole, ...)
     double x_m = 0, y_m = 0;       // axis position, world
-    double diameter_m = 0.1, height_m = 0.3;
-    Yuv colour;
+    double diameter_m = 0.1, height_m = 0.3;  // diameter_m: at the floor (the base of a cone)
+    Yuv colour;                    // the colour when `bands` is empty
+    // Colour bands, TOP TO BOTTOM, heights summing to height_m (load_scene checks: 1e-9). Empty:
+    // one colour (`colour`). A side point at height z (from the floor) takes the colour of the band
+    // containing z; the top cap the top band's. Labels (CleanFrame::label) cover all bands.
+    std::vector<Band> bands;
+    // Shape: < 0 (default) or == diameter_m: a cylinder. Otherwise a truncated cone, the radius
+    // linear in z from diameter_m / 2 at the floor to diameter_top_m / 2 at height_m (0: a full
+    // cone with its apex at the top), closed by a flat top cap when diameter_top_m > 0.
+    double diameter_top_m = -1;
 };
 
 struct Box {                       // box standing on the floor, rotated by yaw about z
@@ -160,11 +178,15 @@ Scene empty_scene();
 // the landmarks', dull orange, dull green, red and yellow clutter, an illumination gradient across
 // the room, cast shadows on the floor, and exposure and white-balance drift over the drive.
 Scene hard_scene();
+// The default room and drive with landmarks of several colours: 6 striped traffic cones
+// (orange / white / orange) and 8 colour-coded cylinders (three bands of green, blue, pink), classes
+// {"orange", "green", "blue", "pink"}, one neutral occluder and one flat orange box.
+Scene multiband_scene();
 // Read / write a scene file (YAML or JSON through cv::FileStorage; docs/synthetic.md). Missing
 // fields keep the defaults of an empty scene. Throws cylfe::Error naming the file and field.
 Scene load_scene(const std::string &path);
 void save_scene(const std::string &path, const Scene &s);
-// "default", "empty", "hard" -> the built-in scenes, otherwise load_scene(path).
+// "default", "empty", "hard", "multiband" -> the built-in scenes, otherwise load_scene(path).
 Scene scene_by_name(const std::string &name_or_path);
 
 // A camera whose intrinsics and mount differ from c by an error drawn once from the sigmas

@@ -299,6 +299,25 @@ SBox screen_box(const CameraModel &cam, const CameraPose &cp, const std::vector<
     return b;
 }
 
+// A truncated cone rather than a cylinder (Cylinder::diameter_top_m)?
+inline bool is_cone(const Cylinder &c) { return c.diameter_top_m >= 0 && c.diameter_top_m != c.diameter_m; }
+
+// The surface colour of a landmark hit at height z above the floor (side) or on its top cap:
+// bands are listed top to bottom; a z on a boundary belongs to the upper band, and the bottom band
+// takes whatever is left (heights that sum to height_m only up to rounding).
+const Yuv &surface_colour(const Cylinder &c, double z, bool cap)
+{
+    if (c.bands.empty()) return c.colour;
+    if (cap) return c.bands.front().colour;
+    double top = c.height_m;
+    for (size_t i = 0; i + 1 < c.bands.size(); i++) {
+        double bottom = top - c.bands[i].height_m;
+        if (z >= bottom) return c.bands[i].colour;
+        top = bottom;
+    }
+    return c.bands.back().colour;
+}
+
 } // namespace
 
 void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out, double t_s) const
@@ -318,7 +337,7 @@ void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out, do
     for (size_t i = 0; i < s.cylinders.size(); i++) {
         const Cylinder &c = s.cylinders[i];
         pts.clear();
-        double R = c.diameter_m / 2;
+        double R = std::max(c.diameter_m, c.diameter_top_m) / 2;  // a cone: its larger end
         for (int k = 0; k < 16; k++) {
             double a = 2 * kPi * k / 16, x = c.x_m + R * 1.09 * std::cos(a), y = c.y_m + R * 1.09 * std::sin(a);
             pts.push_back({x, y, 0.0});
@@ -378,8 +397,60 @@ void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out, do
                 else if (D[1] < -1e-12) { double t = (room.y_min - cp.c[1]) / D[1]; if (t < h.t) { h.t = t; bg = 2; } }
                 int hit_obj = -1;  // -1 background
                 const Obj *ho = nullptr;
+                double hit_z = 0;      // a landmark's hit: height above the floor,
+                bool hit_cap = false;  // on its top cap (for the colour band)
                 for (auto *o : px_objs) {
-                    if (o->kind == 0) {
+                    if (o->kind == 0 && is_cone(s.cylinders[o->idx])) {
+                        // Truncated cone: x^2 + y^2 = R(z)^2, R(z) = R0 + k z, k = (R1 - R0) / H, on the
+                        // ray z = cz + t Dz: R = A0 + A1 t. A quadratic in t; a root counts when it lies
+                        // in 0 <= z <= H on the nappe with R(z) >= 0; the nearest such root (or the cap)
+                        // is the hit.
+                        const Cylinder &c = s.cylinders[o->idx];
+                        const double R0 = c.diameter_m / 2, R1 = c.diameter_top_m / 2, Hc = c.height_m;
+                        const double kc = (R1 - R0) / Hc;
+                        double pxr = cp.c[0] - c.x_m, pyr = cp.c[1] - c.y_m;
+                        double A0 = R0 + kc * cp.c[2], A1 = kc * D[2];
+                        double a = D[0] * D[0] + D[1] * D[1] - A1 * A1;
+                        double b = 2 * (pxr * D[0] + pyr * D[1] - A0 * A1);
+                        double cc = pxr * pxr + pyr * pyr - A0 * A0;
+                        double ts[2];
+                        int nt = 0;
+                        if (std::fabs(a) > 1e-12 * (D[0] * D[0] + D[1] * D[1] + D[2] * D[2])) {
+                            double disc = b * b - 4 * a * cc;
+                            if (disc >= 0) {
+                                // the numerically stable pair of roots
+                                double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
+                                if (q != 0) { ts[nt++] = q / a; ts[nt++] = cc / q; }
+                            }
+                        } else if (b != 0) {
+                            ts[nt++] = -cc / b;  // the ray parallel to a generator: one root
+                        }
+                        for (int j = 0; j < nt; j++) {
+                            double t = ts[j];
+                            if (!(t > 0 && t < h.t)) continue;
+                            double z = cp.c[2] + t * D[2];
+                            if (z < 0 || z > Hc || A0 + A1 * t < 0) continue;
+                            double qx = pxr + t * D[0], qy = pyr + t * D[1], rr = std::hypot(qx, qy);
+                            h.t = t;
+                            // outward normal: the gradient of sqrt(x^2 + y^2) - R(z)
+                            double inv = 1.0 / std::sqrt(1 + kc * kc);
+                            if (rr > 0) { h.n[0] = qx / rr * inv; h.n[1] = qy / rr * inv; h.n[2] = -kc * inv; }
+                            else { h.n[0] = 0; h.n[1] = 0; h.n[2] = 1; }  // the apex
+                            hit_z = z; hit_cap = false;
+                            hit_obj = 0; ho = o;
+                        }
+                        if (R1 > 0 && D[2] != 0) {
+                            double t = (Hc - cp.c[2]) / D[2];
+                            if (t > 0 && t < h.t) {
+                                double qx = pxr + t * D[0], qy = pyr + t * D[1];
+                                if (qx * qx + qy * qy <= R1 * R1) {
+                                    h.t = t; h.n[0] = 0; h.n[1] = 0; h.n[2] = D[2] < 0 ? 1 : -1;
+                                    hit_z = Hc; hit_cap = true;
+                                    hit_obj = 0; ho = o;
+                                }
+                            }
+                        }
+                    } else if (o->kind == 0) {
                         const Cylinder &c = s.cylinders[o->idx];
                         double R = c.diameter_m / 2;
                         double pxr = cp.c[0] - c.x_m, pyr = cp.c[1] - c.y_m;
@@ -393,6 +464,7 @@ void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out, do
                             if (t1 > 0 && t1 < h.t && z >= 0 && z <= c.height_m) {
                                 h.t = t1;
                                 h.n[0] = (pxr + t1 * D[0]) / R; h.n[1] = (pyr + t1 * D[1]) / R; h.n[2] = 0;
+                                hit_z = z; hit_cap = false;
                                 hit_obj = 0; ho = o;
                             }
                         }
@@ -402,6 +474,7 @@ void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out, do
                                 double qx = pxr + t * D[0], qy = pyr + t * D[1];
                                 if (qx * qx + qy * qy <= R * R) {
                                     h.t = t; h.n[0] = 0; h.n[1] = 0; h.n[2] = D[2] < 0 ? 1 : -1;
+                                    hit_z = c.height_m; hit_cap = true;
                                     hit_obj = 0; ho = o;
                                 }
                             }
@@ -440,7 +513,7 @@ void Renderer::render_clean(const Pose2 &robot, double gain, CleanFrame &out, do
                 double shade;
                 Yuv col;
                 if (hit_obj == 0) {
-                    col = s.cylinders[ho->idx].colour;
+                    col = surface_colour(s.cylinders[ho->idx], hit_z, hit_cap);
                     shade = im.ambient + im.diffuse * std::max(0.0, dot3(h.n, L));
                     if (out.want_labels && s.cylinders[ho->idx].landmark) {
                         if (lab == (int32_t)ho->idx) lab_n++;

@@ -21,6 +21,11 @@ constexpr double kDeg = 3.14159265358979323846 / 180.0;
 const Yuv kOrange{137, 68, 194};   // BT.601 of RGB (230, 110, 30)
 const Yuv kGreen{114, 103, 75};    // BT.601 of RGB (40, 160, 70)
 const Yuv kNeutral{96, 131, 125};  // dark blue-grey occluders
+// multiband_scene's further classes and the cones' stripe (BT.601: Y = .299 R + .587 G + .114 B,
+// U = 128 + .564 (B - Y), V = 128 + .713 (R - Y))
+const Yuv kBlue{79, 196, 93};      // RGB (30, 80, 200)
+const Yuv kPink{118, 174, 201};    // RGB (220, 50, 200)
+const Yuv kWhite{200, 128, 128};   // the cones' unclassified stripe
 } // namespace
 
 Scene empty_scene()
@@ -313,6 +318,36 @@ Scene load_scene(const std::string &path)
         r.num(it, "diameter_m", c.diameter_m); r.num(it, "height_m", c.height_m);
         r.yuv(it, "colour", c.colour);
         if (c.diameter_m <= 0 || c.height_m <= 0) throw Error(path + ": cylinder with non-positive size");
+        const std::string where = "cylinders[" + std::to_string(i_cylinders - 1) + "]";
+        r.num(it, "diameter_top_m", c.diameter_top_m);
+        if (std::isnan(c.diameter_top_m))
+            throw Error(path + ": " + where + ".diameter_top_m must be a number (< 0: a cylinder)");
+        const cv::FileNode bands = r.get(it, "bands");
+        if (!bands.empty()) {
+            if (!bands.isSeq())
+                throw Error(path + ": " + where + ".bands must be a sequence of bands {height_m, class, colour}, top to bottom");
+            size_t j = 0;
+            double sum = 0;
+            for (const auto &bn : bands) {
+                const std::string bw = where + ".bands[" + std::to_string(j++) + "]";
+                if (!bn.isMap()) throw Error(path + ": " + bw + " must be a mapping {height_m, class, colour}");
+                r.section(bn, bw);
+                Band b;
+                if (bn["height_m"].empty()) throw Error(path + ": " + bw + ".height_m is missing");
+                r.num(bn, "height_m", b.height_m);
+                if (!(b.height_m > 0)) throw Error(path + ": " + bw + ".height_m must be > 0");
+                b.cls = r.cls(bn, s.classes);
+                r.yuv(bn, "colour", b.colour);
+                sum += b.height_m;
+                c.bands.push_back(b);
+            }
+            if (!c.bands.empty() && !(std::fabs(sum - c.height_m) <= 1e-9)) {
+                char buf[160];
+                std::snprintf(buf, sizeof buf, ": the heights (height_m) of the bands sum to %.9g m, not the height_m %.9g m",
+                              sum, c.height_m);
+                throw Error(path + ": " + where + ".bands" + buf);
+            }
+        }
         s.cylinders.push_back(c);
     }
     size_t i_boxes = 0;
@@ -384,6 +419,17 @@ void save_scene(const std::string &path, const Scene &s)
         fs << "{" << "id" << (int)cy.id << "class" << cname(cy.cls) << "landmark" << (int)cy.landmark << "x_m" << cy.x_m
            << "y_m" << cy.y_m << "diameter_m" << cy.diameter_m << "height_m" << cy.height_m;
         yuv("colour", cy.colour);
+        // written only when used: scene files of one-colour cylinders stay as they were
+        if (cy.diameter_top_m >= 0) fs << "diameter_top_m" << cy.diameter_top_m;
+        if (!cy.bands.empty()) {
+            fs << "bands" << "[";
+            for (const Band &b : cy.bands) {
+                fs << "{" << "height_m" << b.height_m << "class" << cname(b.cls);
+                yuv("colour", b.colour);
+                fs << "}";
+            }
+            fs << "]";
+        }
         fs << "}";
     }
     fs << "]";
@@ -445,11 +491,81 @@ Scene hard_scene()
     return s;
 }
 
+Scene multiband_scene()
+{
+    Scene s = default_scene();  // its room, camera, imaging, drive and odometry
+    s.name = "multiband";
+    s.classes = {"orange", "green", "blue", "pink"};
+    s.cylinders.clear();
+    s.boxes.clear();
+    s.patches.clear();
+    s.landmark_diameter_m = 0.10;
+    s.landmark_height_m = 0.30;
+    const Yuv kColour[] = {kOrange, kGreen, kBlue, kPink};
+    auto band = [&](double h, int32_t cls) {
+        Band b;
+        b.height_m = h;
+        b.cls = cls;
+        b.colour = cls < 0 ? kWhite : kColour[cls];
+        return b;
+    };
+    uint32_t id = 0;
+    // Striped traffic cones: orange / white / orange (top to bottom), 0.30 m tall, 0.25 m at the
+    // base, 0.05 m at the top. The default scene's places of orange landmarks.
+    const double cones[][2] = {{-3.6, 2.4}, {3.7, 2.2}, {-3.9, -0.6}, {1.4, 0.0}, {2.0, -2.6}, {-1.6, -2.7}};
+    for (const auto &p : cones) {
+        Cylinder c;
+        c.id = id++;
+        c.cls = 0;
+        c.landmark = true;
+        c.x_m = p[0];
+        c.y_m = p[1];
+        c.diameter_m = 0.25;
+        c.diameter_top_m = 0.05;
+        c.height_m = 0.30;
+        c.colour = kOrange;
+        c.bands = {band(0.10, 0), band(0.05, -1), band(0.15, 0)};
+        s.cylinders.push_back(c);
+    }
+    // Colour-coded cylinders, 0.10 m x 0.30 m: three 0.10 m bands of green (1), blue (2), pink (3),
+    // top to bottom, no two neighbours alike (they would read as one band); all codes distinct and
+    // of one length, so none is part of another. The default scene's places of green landmarks
+    // and one orange one.
+    struct Coded { double x, y; int32_t code[3]; };
+    const Coded coded[] = {
+        {0.0, 2.5, {1, 2, 3}},  {-1.8, 2.6, {1, 3, 2}}, {1.9, 2.7, {2, 1, 3}},  {3.9, 0.4, {2, 3, 1}},
+        {-1.4, 0.1, {3, 1, 2}}, {3.4, -2.5, {3, 2, 1}}, {0.1, -2.6, {1, 2, 1}}, {-3.6, -2.6, {3, 1, 3}},
+    };
+    for (const Coded &k : coded) {
+        Cylinder c;
+        c.id = id++;
+        c.cls = k.code[0];  // the class the truth reports: the top band's
+        c.landmark = true;
+        c.x_m = k.x;
+        c.y_m = k.y;
+        c.diameter_m = s.landmark_diameter_m;
+        c.height_m = s.landmark_height_m;
+        c.colour = kColour[k.code[0]];
+        for (int32_t cls : k.code) c.bands.push_back(band(0.10, cls));
+        s.cylinders.push_back(c);
+    }
+    Box flat;  // a flat orange box lying on the floor (clutter in a landmark colour)
+    flat.cls = 0; flat.x_m = -0.7; flat.y_m = 2.0; flat.yaw_rad = 20 * kDeg;
+    flat.size_x_m = 0.5; flat.size_y_m = 0.35; flat.size_z_m = 0.06; flat.colour = kOrange;
+    s.boxes.push_back(flat);
+    Box occ;  // a neutral occluder
+    occ.cls = -1; occ.size_x_m = 0.35; occ.size_y_m = 0.35; occ.size_z_m = 0.6; occ.colour = kNeutral;
+    occ.x_m = -2.9; occ.y_m = 1.9; occ.yaw_rad = 10 * kDeg;
+    s.boxes.push_back(occ);
+    return s;
+}
+
 Scene scene_by_name(const std::string &n)
 {
     if (n == "default") return default_scene();
     if (n == "empty") return empty_scene();
     if (n == "hard") return hard_scene();
+    if (n == "multiband") return multiband_scene();
     return load_scene(n);
 }
 

@@ -26,7 +26,7 @@ void train_colortable(const Scene &scene, cyl_colortable *t, uint64_t seed, std:
         check(cyl_colortable_set_class(t, (unsigned)c, scene.classes[c].c_str(), kDisplay[c][0], kDisplay[c][1],
                                        kDisplay[c][2]),
               "colour table class");
-    // One colour per class: the first landmark (or any object) of the class.
+    // One colour per class: the first one-colour landmark of the class, else the first band of it.
     Scene s = empty_scene();
     s.camera = scene.camera;
     s.imaging = scene.imaging;
@@ -42,8 +42,25 @@ void train_colortable(const Scene &scene, cyl_colortable *t, uint64_t seed, std:
     if (params) tp = *params;
     for (size_t c = 0; c < scene.classes.size() && c < CYL_MAX_CLASSES; c++) {
         const Cylinder *proto = nullptr;
+        Cylinder from_band;
         for (const Cylinder &cy : scene.cylinders)
-            if (cy.cls == (int32_t)c && cy.landmark) { proto = &cy; break; }
+            if (cy.cls == (int32_t)c && cy.landmark && cy.bands.empty()) { proto = &cy; break; }
+        // No one-colour landmark of the class: a band of that class (a striped or coded landmark)
+        // stands for it, as a plain cylinder of the band's colour and the landmark's size.
+        for (size_t i = 0; !proto && i < scene.cylinders.size(); i++) {
+            const Cylinder &cy = scene.cylinders[i];
+            if (!cy.landmark) continue;
+            for (const Band &b : cy.bands)
+                if (b.cls == (int32_t)c) {
+                    from_band = cy;
+                    from_band.cls = b.cls;
+                    from_band.colour = b.colour;
+                    from_band.bands.clear();
+                    from_band.diameter_top_m = -1;
+                    proto = &from_band;
+                    break;
+                }
+        }
         if (!proto) continue;
         // Training views: the landmark seen from 8 directions around it (so that lit and shaded
         // sides are both in view), at three ranges, off-centre, under five exposures.
