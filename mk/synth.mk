@@ -64,3 +64,13 @@ TEST_EXTRA_BINS += tests/synth/test_consistency_quick.sh:$(BUILD)
 # statistics, not memory safety: 662 of the sanitizer run's 1,099 s of tests, while render, detect
 # and the sweep's code run under the sanitizers in the other tests
 SAN_SKIP += tests/synth/test_consistency_quick.sh:$(BUILD)
+
+# make multiband: landmarks of several colours (striped cones, coded cylinders) on held-out drives of
+# the multiband scene: one observation per landmark, identities, range bias, SLAM with and without
+# identities (scripts/multiband.py; last line JSON); make test runs its --quick form.
+multiband: $(BUILD)/cyl $(BUILD)/cyl-render .venv/.stamp
+	@.venv/bin/python scripts/multiband.py --build $(BUILD)
+.PHONY: multiband
+TEST_EXTRA_BINS += tests/synth/test_multiband_quick.sh:$(BUILD)
+# statistics, not memory safety: grouping and observing run under the sanitizers in the unit tests
+SAN_SKIP += tests/synth/test_multiband_quick.sh:$(BUILD)
