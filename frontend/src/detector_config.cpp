@@ -143,7 +143,7 @@ void read_landmarks(const Reader &r, const YAML::Node &n, const cyl_colortable &
         if (!m["name"].IsScalar() || m["name"].Scalar().empty()) r.fail(m["name"], where + ".name: expected a name");
         const std::string name = m["name"].Scalar();
         for (const std::string &other : cfg.model_names)
-            if (other == name) r.fail(m["name"], where + ".name: '" + name + "' names two models");
+            if (other == name) r.fail(m["name"], std::string(where).append(".name: '").append(name).append("' names two models"));
         cyl_landmark_model md{};
         md.id = -1;
         const YAML::Node bands = m["bands"];
@@ -163,10 +163,10 @@ void read_landmarks(const Reader &r, const YAML::Node &n, const cyl_colortable &
                 std::vector<std::string> names = {"gap"};
                 for (unsigned c = 0; c < CYL_MAX_CLASSES; c++)
                     if (table.name[c][0]) names.push_back(table.name[c]);
-                r.fail(bands[k], where + ".bands: '" + b + "' is not a class of the table" + did_you_mean(b, names));
+                r.fail(bands[k], std::string(where).append(".bands: '").append(b).append("' is not a class of the table").append(did_you_mean(b, names)));
             }
             if (table.weak_of[cls] != CYL_CLASS_NONE)
-                r.fail(bands[k], where + ".bands: '" + b + "' is a weak class (its pixels join its class's blobs)");
+                r.fail(bands[k], std::string(where).append(".bands: '").append(b).append("' is a weak class (its pixels join its class's blobs)"));
             md.band_cls[k] = (uint8_t)cls;
         }
         std::vector<double> h = r.list(m["band_heights_m"], where + ".band_heights_m", bands.size(), 1e-4, 100, false);
@@ -188,7 +188,7 @@ void read_landmarks(const Reader &r, const YAML::Node &n, const cyl_colortable &
             md.diameter_bottom_m = d[0];
             md.diameter_top_m = d[1];
         } else {
-            r.fail(m["shape"], where + ".shape: '" + shape + "' is not cylinder or cone");
+            r.fail(m["shape"], std::string(where).append(".shape: '").append(shape).append("' is not cylinder or cone"));
         }
         if (m["id"]) md.id = (int32_t)r.number(m["id"], where + ".id", 0, 2147483647.0, true);
         cfg.models.push_back(md);
@@ -351,7 +351,8 @@ std::string detector_config_yaml(const DetectorConfig &cfg, const cyl_colortable
                 std::snprintf(b, sizeof b, "%s%.6g", k ? ", " : "", m.band_height_m[k]);
                 hs += b;
             }
-            s += "    - name: " + cfg.model_names[i] + "\n      bands: [" + bands + "]\n      band_heights_m: [" + hs + "]\n";
+            s.append("    - name: ").append(cfg.model_names[i]).append("\n      bands: [").append(bands);
+            s.append("]\n      band_heights_m: [").append(hs).append("]\n");
             if (m.shape == CYL_SHAPE_CONE)
                 std::snprintf(b, sizeof b, "      shape: cone\n      diameter_m: [%.6g, %.6g]\n", m.diameter_bottom_m,
                               m.diameter_top_m);

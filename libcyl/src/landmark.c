@@ -332,7 +332,7 @@ static void fill_group(const grp_ctx *c, uint16_t mi, const band_geom *g, const 
 static void judge_group(grp_ctx *c, cyl_group *o)
 {
     const cyl_landmark_model *m = &c->models[o->model];
-    uint32_t members[CYL_MODEL_MAX_BANDS], n = 0, b, mi;
+    uint32_t members[CYL_MODEL_MAX_BANDS] = {CYL_NONE, CYL_NONE, CYL_NONE, CYL_NONE}, n = 0, b, mi;
     int k;
     for (k = 0; k < CYL_MODEL_MAX_BANDS; k++)
         if (o->blob[k] != CYL_NONE) members[n++] = o->blob[k];

@@ -321,21 +321,21 @@ Scene load_scene(const std::string &path)
         const std::string where = "cylinders[" + std::to_string(i_cylinders - 1) + "]";
         r.num(it, "diameter_top_m", c.diameter_top_m);
         if (std::isnan(c.diameter_top_m))
-            throw Error(path + ": " + where + ".diameter_top_m must be a number (< 0: a cylinder)");
+            throw Error(std::string(path).append(": ").append(where).append(".diameter_top_m must be a number (< 0: a cylinder)"));
         const cv::FileNode bands = r.get(it, "bands");
         if (!bands.empty()) {
             if (!bands.isSeq())
-                throw Error(path + ": " + where + ".bands must be a sequence of bands {height_m, class, colour}, top to bottom");
+                throw Error(std::string(path).append(": ").append(where).append(".bands must be a sequence of bands {height_m, class, colour}, top to bottom"));
             size_t j = 0;
             double sum = 0;
             for (const auto &bn : bands) {
                 const std::string bw = where + ".bands[" + std::to_string(j++) + "]";
-                if (!bn.isMap()) throw Error(path + ": " + bw + " must be a mapping {height_m, class, colour}");
+                if (!bn.isMap()) throw Error(std::string(path).append(": ").append(bw).append(" must be a mapping {height_m, class, colour}"));
                 r.section(bn, bw);
                 Band b;
-                if (bn["height_m"].empty()) throw Error(path + ": " + bw + ".height_m is missing");
+                if (bn["height_m"].empty()) throw Error(std::string(path).append(": ").append(bw).append(".height_m is missing"));
                 r.num(bn, "height_m", b.height_m);
-                if (!(b.height_m > 0)) throw Error(path + ": " + bw + ".height_m must be > 0");
+                if (!(b.height_m > 0)) throw Error(std::string(path).append(": ").append(bw).append(".height_m must be > 0"));
                 b.cls = r.cls(bn, s.classes);
                 r.yuv(bn, "colour", b.colour);
                 sum += b.height_m;
@@ -345,7 +345,7 @@ Scene load_scene(const std::string &path)
                 char buf[160];
                 std::snprintf(buf, sizeof buf, ": the heights (height_m) of the bands sum to %.9g m, not the height_m %.9g m",
                               sum, c.height_m);
-                throw Error(path + ": " + where + ".bands" + buf);
+                throw Error(std::string(path).append(": ").append(where).append(".bands").append(buf));
             }
         }
         s.cylinders.push_back(c);
