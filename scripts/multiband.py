@@ -33,30 +33,13 @@ import json
 import math
 import os
 import re
-import subprocess
 import sys
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from consistency import run, seeds_arg  # noqa: E402  (the scripts' shared runner and seed list)
+
 W, H = 640, 480
-
-
-def run(cmd, env=None):
-    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
-    if p.returncode != 0:
-        sys.stderr.write(" ".join(cmd) + f" failed (exit {p.returncode}):\n" + p.stderr[-2000:])
-        sys.exit(1)
-    return p.stdout
-
-
-def seeds_arg(s):
-    out = []
-    for part in s.split(","):
-        m = re.fullmatch(r"(\d+)(?:-(\d+))?", part.strip())
-        if not m:
-            raise argparse.ArgumentTypeError(f"seeds: expected e.g. 101-103 or 101,105, got '{s}'")
-        a, b = int(m.group(1)), int(m.group(2) or m.group(1))
-        out += list(range(a, b + 1))
-    return out
 
 
 def read_scene(path):

@@ -124,7 +124,11 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
     size_t k = 0;
     boxes_.clear();
     members_.clear();
-    size_t gi = 0;
+    // each grouped observation's group, by its first blob (a blob is in one group at most)
+    group_of_blob_.assign(grouped ? seg_.n_blobs : 0, CYL_NONE);
+    for (size_t g = 0; g < groups_.size() && grouped; g++)
+        for (uint32_t bb : groups_[g].blob)
+            if (bb < seg_.n_blobs) group_of_blob_[bb] = (uint32_t)g;
     for (size_t i = 0; i < obs_.size(); i++) {
         const cyl_observation &o = obs_[i];
         const cyl_blob &b = seg_.blobs[o.blob];
@@ -134,27 +138,11 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
         members[0] = o.blob;
         bool keep;
         if (o.model != CYL_NO_MODEL) {
-            // a grouped landmark: the groups were observed in order, each that gave an observation
-            while (gi < groups_.size() && groups_[gi].model != o.model) gi++;
-            while (gi < groups_.size()) {
-                bool member = false;
-                for (uint32_t bb : groups_[gi].blob) member = member || bb == o.blob;
-                if (member) break;
-                gi++;
-            }
-            if (gi < groups_.size()) {
-                const cyl_group &g = groups_[gi++];
-                box = {g.x0, g.y0, g.x1, g.y1};
-                std::copy(g.blob, g.blob + CYL_MODEL_MAX_BANDS, members.begin());
-            }
+            const cyl_group &g = groups_[group_of_blob_[o.blob]];
+            box = {g.x0, g.y0, g.x1, g.y1};
+            std::copy(g.blob, g.blob + CYL_MODEL_MAX_BANDS, members.begin());
             // only the mask applies: the per-class gates judge one-colour blobs
-            keep = true;
-            if (masked) {
-                long x = std::lround(o.centroid_u_px), y = std::lround(o.centroid_v_px);
-                if (x >= 0 && y >= 0 && x < (long)img.width && y < (long)img.height &&
-                    config_.mask[(size_t)y * img.width + (size_t)x] == 0)
-                    keep = false;
-            }
+            keep = mask_keeps(config_, o.centroid_u_px, o.centroid_v_px, img.width, img.height);
         } else {
             const ClassGate &g = config_.gate[o.cls];
             keep = blob_passes(config_, b, img.width, img.height);
@@ -190,13 +178,15 @@ bool blob_passes(const DetectorConfig &cfg, const cyl_blob &b, uint32_t frame_wi
     if (g.aspect_min > 0 && !width_cut && w < g.aspect_min * h) return false;
     if (g.aspect_max > 0 && !height_cut && w > g.aspect_max * h) return false;
     if (g.min_fill > 0 && (double)b.area < g.min_fill * w * h) return false;
-    if (!cfg.mask.empty() && cfg.mask_width == frame_width && cfg.mask_height == frame_height) {
-        long x = std::lround(b.cx_px), y = std::lround(b.cy_px);
-        if (x >= 0 && y >= 0 && x < (long)frame_width && y < (long)frame_height &&
-            cfg.mask[(size_t)y * frame_width + (size_t)x] == 0)
-            return false;
-    }
-    return true;
+    return mask_keeps(cfg, b.cx_px, b.cy_px, frame_width, frame_height);
+}
+
+bool mask_keeps(const DetectorConfig &cfg, double x_px, double y_px, uint32_t frame_width, uint32_t frame_height)
+{
+    if (cfg.mask.empty() || cfg.mask_width != frame_width || cfg.mask_height != frame_height) return true;
+    const long x = std::lround(x_px), y = std::lround(y_px);
+    return !(x >= 0 && y >= 0 && x < (long)frame_width && y < (long)frame_height &&
+             cfg.mask[(size_t)y * frame_width + (size_t)x] == 0);
 }
 
 void load_detector_mask(const std::string &path, DetectorConfig &cfg)

@@ -158,6 +158,15 @@ static void locate(cyl_observation *o, const cyl_camera *cam, const cyl_observe_
 static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *cam, const cyl_observe_params *p,
                                 size_t work_size, uint32_t cap, const void *out, const uint32_t *n_out);
 
+/* A blob's centroid and its variance by the chosen estimator. */
+static cyl_status blob_noise(const cyl_segmentation *seg, const cyl_blob *b, const cyl_observe_params *p, void *work,
+                             size_t work_size, cyl_centroid_noise *cn)
+{
+    if (p->estimator == CYL_NOISE_IMAGE)
+        return cyl_noise_blob_image(seg, b, p->image, p->table, &p->image_noise, cn);
+    return cyl_noise_blob(seg, b, p->estimator, work, work_size, cn);
+}
+
 cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
                        const cyl_observe_params *p, void *work, size_t work_size,
                        cyl_observation *out, uint32_t cap, uint32_t *n_out)
@@ -174,10 +183,7 @@ cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
         if (b->cls >= CYL_MAX_CLASSES || !(p->class_mask & (1u << b->cls))) continue;
         if (b->area < p->min_area) continue;
         if (n == cap) { ret = CYL_TRUNCATED; break; }
-        if (p->estimator == CYL_NOISE_IMAGE)
-            st = cyl_noise_blob_image(seg, b, p->image, p->table, &p->image_noise, &cn);
-        else
-            st = cyl_noise_blob(seg, b, p->estimator, work, work_size, &cn);
+        st = blob_noise(seg, b, p, work, work_size, &cn);
         if (st == CYL_ERR_EMPTY) continue;
         if (st != CYL_OK) return st;
         o = &out[n++];
@@ -243,7 +249,6 @@ cyl_status cyl_observe_groups(const cyl_segmentation *seg, const cyl_group *grou
         const cyl_landmark_model *m = &models[g->model];
         cyl_observation *o;
         double sx = 0.0, sy = 0.0, vx = 0.0, vy = 0.0, total_h = 0.0;
-        double cn_n[CYL_MODEL_MAX_BANDS], cn_vx[CYL_MODEL_MAX_BANDS], cn_vy[CYL_MODEL_MAX_BANDS];
         uint32_t mask = 0, first = CYL_NONE, blob_flags = 0, nsamp = 0;
         int k;
         shape_ref sh;
@@ -253,34 +258,25 @@ cyl_status cyl_observe_groups(const cyl_segmentation *seg, const cyl_group *grou
             const cyl_blob *b;
             cyl_centroid_noise cn;
             total_h += m->band_height_m[k];
-            cn_n[k] = 0.0;
             if (bi == CYL_NONE) continue;
             if (bi >= seg->n_blobs) return CYL_ERR_ARG;
             b = &seg->blobs[bi];
-            if (p->estimator == CYL_NOISE_IMAGE)
-                st = cyl_noise_blob_image(seg, b, p->image, p->table, &p->image_noise, &cn);
-            else
-                st = cyl_noise_blob(seg, b, p->estimator, work, work_size, &cn);
+            st = blob_noise(seg, b, p, work, work_size, &cn);
             if (st == CYL_ERR_EMPTY) continue;
             if (st != CYL_OK) return st;
             if (first == CYL_NONE) first = bi;
             mask |= 1u << k;
             blob_flags |= b->flags;
             nsamp += cn.n;
-            cn_n[k] = (double)cn.n;
-            cn_vx[k] = cn.var_x_px2;
-            cn_vy[k] = cn.var_y_px2;
+            vx += (double)cn.n * (double)cn.n * cn.var_x_px2;   /* divided by N^2 below */
+            vy += (double)cn.n * (double)cn.n * cn.var_y_px2;
             sx += (double)cn.n * cn.cx_px;
             sy += (double)cn.n * cn.cy_px;
         }
         if (!mask || nsamp == 0) continue;
         if (n == cap) { ret = CYL_TRUNCATED; break; }
-        for (k = 0; k < m->n_bands; k++) {
-            const double w = cn_n[k] / (double)nsamp;
-            if (cn_n[k] == 0.0) continue;
-            vx += w * w * cn_vx[k];
-            vy += w * w * cn_vy[k];
-        }
+        vx /= (double)nsamp * (double)nsamp;
+        vy /= (double)nsamp * (double)nsamp;
         o = &out[n++];
         memset(o, 0, sizeof *o);
         o->blob = first;

@@ -238,7 +238,7 @@ class Slam:
         assoc = []
         st = dict(obs_total=0, dropped_flags=0, dropped_no_range=0, dropped_confidence=0, dropped_far=0,
                   dropped_ambiguous=0, dropped_imprecise=0, used=0, new_landmarks=0, isam_updates=0,
-                  marginal_calls=0, association=mode)
+                  marginal_calls=0, association=mode, by_identity=0)
         last_update = 0
         gate = chi2_2dof(p.gate_p)
         new_thr = chi2_2dof(p.new_p)
@@ -296,7 +296,7 @@ class Slam:
                                           lms_init, lm_class, by_class, gate, new_thr, st)
                     for k, t in zip(rest, got):
                         targets[k] = t
-                st["by_identity"] = st.get("by_identity", 0) + len(usable) - len(rest)
+                st["by_identity"] += len(usable) - len(rest)
             else:
                 targets = self._associate(isam, i, cur, usable, covs, lms_init, lm_class,
                                           by_class, gate, new_thr, st)

@@ -56,6 +56,8 @@ uint32_t model_classes(const DetectorConfig &cfg);
 
 // The gates that need no camera (area, aspect, fill, mask) on one blob of a frame.
 bool blob_passes(const DetectorConfig &cfg, const cyl_blob &b, uint32_t frame_width, uint32_t frame_height);
+// The mask's verdict on a point of a frame (true: keep; no mask, or one of another size: true).
+bool mask_keeps(const DetectorConfig &cfg, double x_px, double y_px, uint32_t frame_width, uint32_t frame_height);
 
 // Read a detector config file (YAML, docs/formats.md) into cfg, naming the class indices through
 // table. Unknown keys and classes are errors naming the line; the mask path is relative to the
@@ -106,6 +108,7 @@ private:
     std::vector<std::array<uint32_t, CYL_MODEL_MAX_BANDS>> members_;
     std::vector<uint8_t> group_work_;
     std::vector<cyl_group> groups_;
+    std::vector<uint32_t> group_of_blob_;
     bool truncated_ = false;
     uint64_t rejected_ = 0;
 };
