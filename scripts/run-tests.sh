@@ -36,7 +36,7 @@ run_one() {
   fi
 }
 bad_result() { [ "$rc" -ne 0 ] || [ "$f" -gt 0 ] || [ "$p" -eq 0 ]; }
-failure_lines() { grep -aE 'FAILED|ERROR|Assert|error|failure|Failure|Sanitizer|runtime error' "$1" | head -40 | sed 's/^/      /'; }
+failure_lines() { grep -aE 'FAILED|ERROR|Assert|error|failure|Failure|check failed|Sanitizer|runtime error' "$1" | head -40 | sed 's/^/      /'; }
 
 for t in "$@"; do
   out=$(mktemp)
