@@ -156,8 +156,6 @@ class Params:
     update_every: int = 10         # iSAM2 update at least every N steps (and every observed one)
     batch: bool = True             # final batch Levenberg-Marquardt
     covariances: bool = True       # compute marginals after the batch pass
-    joint_max_dim: int = 9000      # also the joint covariance of all poses (and of all landmarks) when
-                                   # it has at most this many rows (the joint NEES, metrics.py)
     calib_states: bool = False     # estimate the calibration error (constant over the run) as a state
 
 
@@ -172,8 +170,7 @@ class Result:
     lm_ids: list                          # known identity per landmark (or None)
     assoc: list                           # (step index, Obs, landmark index) per used observation
     stats: dict = field(default_factory=dict)
-    pose_joint_cov: Optional[np.ndarray] = None  # (3N, 3N) joint covariance of all poses, or None
-    lm_joint_cov: Optional[np.ndarray] = None    # (2M, 2M) joint covariance of all landmarks, or None
+    info: Optional["Information"] = None  # the information matrix at the estimate (joint NEES)
 
 
 class Slam:
@@ -350,17 +347,16 @@ class Slam:
         poses = _poses(est, n)
         m = len(lms_init)
         lms = np.array([[est.atPoint2(L(j))[0], est.atPoint2(L(j))[1]] for j in range(m)]).reshape(m, 2)
-        pose_cov = lm_cov = pose_joint = lm_joint = None
+        pose_cov = lm_cov = info = None
         if p.covariances:
             marg = gtsam.Marginals(graph, est)
             pose_cov = np.array([marg.marginalCovariance(X(i)) for i in range(n)])
             lm_cov = np.array([marg.marginalCovariance(L(j)) for j in range(m)]).reshape(m, 2, 2)
             # Poses share every earlier odometry step, and landmarks the poses and the calibration:
-            # their errors are correlated, and only the joint covariance whitens them together.
-            if 0 < 3 * n <= p.joint_max_dim:
-                pose_joint = marg.jointMarginalCovariance(gtsam.KeyVector([X(i) for i in range(n)])).fullMatrix()
-            if 0 < 2 * m <= p.joint_max_dim:
-                lm_joint = marg.jointMarginalCovariance(gtsam.KeyVector([L(j) for j in range(m)])).fullMatrix()
+            # their errors are correlated, and only the joint covariance whitens them together. Its
+            # inverse over any set of variables is a Schur complement of the sparse information
+            # matrix, cheap at any size (a dense joint covariance of 3,000 poses is not).
+            info = Information(graph, est)
         st["t_isam_s"] = round(t_isam, 3)
         st["t_batch_s"] = round(t_batch, 3)
         st["t_total_s"] = round(time.perf_counter() - t0, 3)
@@ -371,7 +367,7 @@ class Slam:
             st["calib_error_estimate"] = [float(x) for x in est.atVector(CALIB)]
         return Result(poses=poses, pose_cov=pose_cov, isam_poses=isam_poses, lms=lms,
                       lm_cov=lm_cov, lm_class=lm_class, lm_ids=lm_ids, assoc=assoc, stats=st,
-                      pose_joint_cov=pose_joint, lm_joint_cov=lm_joint)
+                      info=info)
 
     def _associate(self, isam, i, cur, usable, covs, lms_init, lm_class, by_class, gate,
                    new_thr, st):
@@ -438,6 +434,51 @@ class Slam:
             else:
                 out.append(-1)
         return out
+
+
+class Information:
+    """The information matrix H = J^T J of the graph linearised at the estimate (sparse; robust
+    kernels' weights included, as in gtsam.Marginals), with the columns of each variable."""
+
+    def __init__(self, graph, values):
+        import scipy.sparse as sp
+        keys = sorted(values.keys())      # the column order of GaussianFactorGraph.sparseJacobian_
+        self.cols = {}
+        c = 0
+        for k in keys:
+            d = _dim(values, k)
+            self.cols[k] = np.arange(c, c + d)
+            c += d
+        ijs = graph.linearize(values).sparseJacobian_()
+        i, j, v = ijs[0].astype(int) - 1, ijs[1].astype(int) - 1, ijs[2]
+        keep = j < c                      # the last column is the right-hand side b
+        J = sp.csc_matrix((v[keep], (i[keep], j[keep])), shape=(int(i.max()) + 1, c))
+        self.H = (J.T @ J).tocsc()
+        self.n = c
+
+    def columns(self, keys):
+        return np.concatenate([self.cols[k] for k in keys]) if keys else np.zeros(0, int)
+
+    def nees(self, keys, err):
+        """e^T Sigma_S^-1 e for the stacked tangent-space error e of the variables `keys`, Sigma_S
+        their joint marginal covariance: Sigma_S^-1 = H_SS - H_SO H_OO^-1 H_OS (O: all others)."""
+        import scipy.sparse as sp
+        import scipy.sparse.linalg as spl
+        s = self.columns(keys)
+        o = np.setdiff1d(np.arange(self.n), s)
+        e = np.asarray(err, float)
+        v = float(e @ (self.H[s][:, s] @ e))
+        if len(o):
+            Hos = self.H[o][:, s]
+            w = Hos @ e
+            Hoo = sp.csc_matrix(self.H[o][:, o])
+            v -= float(w @ spl.splu(Hoo).solve(w))
+        return v
+
+
+def _dim(values, key):
+    sym = gtsam.Symbol(key)
+    return {"x": 3, "l": 2}.get(chr(sym.chr()), None) or values.atVector(key).shape[0]
 
 
 def _poses(values, n):

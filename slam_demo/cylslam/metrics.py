@@ -191,11 +191,11 @@ def evaluate(ds, res):
             a, bnd = anees(errs, [res.pose_cov[i] for i in idx])
             out["anees_poses"] = a
             out["anees_poses_bounds95"] = list(bnd)
-            if res.pose_joint_cov is not None:
-                sel = np.concatenate([[3 * i, 3 * i + 1, 3 * i + 2] for i in idx])
-                a, bnd = anees_joint(np.concatenate(errs), res.pose_joint_cov[np.ix_(sel, sel)])
-                out["anees_poses_joint"] = a
-                out["anees_poses_joint_bounds95"] = list(bnd)
+            if res.info is not None:
+                from .backend import X
+                e = np.concatenate(errs)
+                out["anees_poses_joint"] = res.info.nees([X(i) for i in idx], e) / len(e)
+                out["anees_poses_joint_bounds95"] = list(anees_bounds(len(e), 1))
         out["_align"] = (R, t)
     if ds.truth_landmarks:
         labels = truth_labels(ds, res)
@@ -217,10 +217,10 @@ def evaluate(ds, res):
                 a, bnd = anees(list(est - tr), [res.lm_cov[j] for j in js])
                 out["anees_landmarks"] = a
                 out["anees_landmarks_bounds95"] = list(bnd)
-                if res.lm_joint_cov is not None:
-                    sel = np.concatenate([[2 * j, 2 * j + 1] for j in js])
-                    a, bnd = anees_joint((est - tr).reshape(-1), res.lm_joint_cov[np.ix_(sel, sel)])
-                    out["anees_landmarks_joint"] = a
-                    out["anees_landmarks_joint_bounds95"] = list(bnd)
+                if res.info is not None:
+                    from .backend import L
+                    e = (est - tr).reshape(-1)
+                    out["anees_landmarks_joint"] = res.info.nees([L(j) for j in js], e) / len(e)
+                    out["anees_landmarks_joint_bounds95"] = list(anees_bounds(len(e), 1))
         out["_match"] = mp
     return out

@@ -177,3 +177,54 @@ def test_mixed_association_uses_identities_where_given():
     res = backend.Slam(backend.Params(assoc="auto", gate_p=0.999999, new_p=0.9999999)).run(ds)
     assert res.stats["association"] == "unknown"
     assert [j for (_, _, j) in res.assoc][:2] == [0, 0]
+
+
+def test_joint_nees_from_information_matches_dense_joint_covariance():
+    # A small graph with every kind of variable the back end makes (poses, landmarks, a vector
+    # state) and a robust kernel: e^T Sigma_S^-1 e from the sparse information matrix's Schur
+    # complement equals the same with gtsam.Marginals' dense joint covariance, for pose subsets,
+    # landmark sets and mixed sets.
+    rng = np.random.default_rng(3)
+    g = gtsam.NonlinearFactorGraph()
+    v = gtsam.Values()
+    g.add(gtsam.PriorFactorPose2(backend.X(0), gtsam.Pose2(0, 0, 0), gtsam.noiseModel.Diagonal.Sigmas([1e-2, 1e-2, 1e-3])))
+    v.insert(backend.X(0), gtsam.Pose2(0, 0, 0))
+    g.add(gtsam.PriorFactorVector(backend.CALIB, np.zeros(8), gtsam.noiseModel.Isotropic.Sigma(8, 0.1)))
+    v.insert(backend.CALIB, np.zeros(8))
+    lms = rng.uniform(-3, 3, (4, 2)) + [4, 0]
+    for j, p in enumerate(lms):
+        v.insert(backend.L(j), gtsam.Point2(*(p + rng.normal(0, 0.05, 2))))
+    huber = gtsam.noiseModel.Robust.Create(gtsam.noiseModel.mEstimator.Huber.Create(1.0),
+                                           gtsam.noiseModel.Diagonal.Sigmas([0.01, 0.05]))
+    for i in range(6):
+        if i:
+            g.add(gtsam.BetweenFactorPose2(backend.X(i - 1), backend.X(i), gtsam.Pose2(0.3, 0, 0.05),
+                                           gtsam.noiseModel.Diagonal.Sigmas([0.02, 0.01, 0.01])))
+            v.insert(backend.X(i), gtsam.Pose2(0.3 * i, 0.01 * i, 0.05 * i))
+        for j, p in enumerate(lms):
+            pose = gtsam.Pose2(0.3 * i, 0, 0.05 * i)
+            b = pose.bearing(gtsam.Point2(*p)).theta() + rng.normal(0, 0.01)
+            r = pose.range(gtsam.Point2(*p)) + rng.normal(0, 0.05)
+            g.add(gtsam.BearingRangeFactor2D(backend.X(i), backend.L(j), gtsam.Rot2(b), r, huber))
+    # the calibration state enters through its prior only here; tie it to a landmark so that the
+    # Schur complement has off-diagonal blocks to remove
+    g.add(gtsam.CustomFactor(gtsam.noiseModel.Isotropic.Sigma(2, 0.1), [backend.L(0), backend.CALIB],
+                             lambda f, vals, H: _tie(vals, H)))
+    est = gtsam.LevenbergMarquardtOptimizer(g, v).optimize()
+    info = backend.Information(g, est)
+    marg = gtsam.Marginals(g, est)
+    for keys in ([backend.X(i) for i in range(6)], [backend.X(1), backend.X(4)],
+                 [backend.L(j) for j in range(4)], [backend.L(2)], [backend.X(3), backend.L(1)]):
+        dense = marg.jointMarginalCovariance(gtsam.KeyVector(keys)).fullMatrix()
+        e = rng.normal(0, 0.1, dense.shape[0])
+        want = float(e @ np.linalg.solve(dense, e))
+        assert info.nees(keys, e) == pytest.approx(want, rel=1e-6)
+
+
+def _tie(vals, H):
+    lm = vals.atPoint2(backend.L(0))
+    c = vals.atVector(backend.CALIB)
+    if H is not None:
+        H[0] = np.eye(2)
+        H[1] = np.hstack([-np.eye(2), np.zeros((2, 6))])
+    return np.array([lm[0] - c[0] - 4.0, lm[1] - c[1]])
