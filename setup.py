@@ -12,6 +12,7 @@ setup(
     version=VERSION,
     packages=["cyl", "cylslam"],
     package_dir={"cyl": "python/cyl", "cylslam": "slam_demo/cylslam"},
+    package_data={"cylslam": ["models/*.json"]},
     cffi_modules=["python/cyl/_build.py:ffibuilder"],
     zip_safe=False,
 )

@@ -25,7 +25,7 @@ TEST_EXTRA_BINS += pytest:slam_demo/run_tests.sh
 # pure Python: nothing in it for the sanitizers
 SAN_SKIP += pytest:slam_demo/run_tests.sh
 
-.PHONY: slam-venv slam-test slam-synth mrclam victoria slam-run
+.PHONY: slam-venv slam-test slam-synth mrclam mrclam-noise victoria slam-run
 slam-venv: $(VENV)/.stamp
 
 slam-test: $(VENV)/.stamp
@@ -40,6 +40,12 @@ mrclam: $(VENV)/.stamp
 	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc known --out $(SLAM_OUT)/mrclam-known \
 	  --check-rmse 0.15 --check-time 30
 	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc unknown --odom-scale 4 --out $(SLAM_OUT)/mrclam-unknown
+	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc known --noise learned --out $(SLAM_OUT)/mrclam-known-learned
+
+# the noise model learned from MRCLAM Dataset 7's residuals against its truth (the shipped
+# slam_demo/cylslam/models/mrclam_noise.json was written by this, from ../shared's Dataset 7)
+mrclam-noise: $(VENV)/.stamp
+	$(CYLSLAM) mrclam-noise --dir $(MRCLAM_DIR) --out $(SLAM_OUT)/mrclam_noise.json
 
 victoria: $(VENV)/.stamp
 	$(CYLSLAM) victoria --out $(SLAM_OUT)/victoria

@@ -148,8 +148,10 @@ class Params:
     reject_flags: int = FLAGS_REJECT  # obs.flags bits that drop an observation (format: 0x320)
     max_range_rel_sigma: Optional[float] = None  # drop an observation whose range sigma exceeds this
                                    # times its range (its range is then far from Gaussian); None: keep
-    robust: str = "none"           # none | huber
-    huber_k: float = 1.345         # Huber threshold on the whitened residual
+    robust: str = "none"           # none | huber | cauchy
+    huber_k: float = 1.345         # the kernel's threshold k on the whitened residual (Huber or Cauchy)
+    odom_robust: str = "none"      # none | huber | cauchy: kernel on the odometry factors (a learned
+    odom_robust_k: float = 2.0     # noise model's, noise_model.py), and its threshold
     fixed_cov: Optional[np.ndarray] = None   # replaces every observation covariance (r, b order)
     anchor: str = "truth"          # truth | origin
     prior_sigmas: tuple = (1e-3, 1e-3, 1e-4)
@@ -182,11 +184,23 @@ class Slam:
         self.progress = progress
         self.on_step = on_step
 
+    def _odom_noise(self, cov):
+        g = gtsam.noiseModel.Gaussian.Covariance(np.asarray(cov, float))
+        if self.p.odom_robust == "cauchy":
+            return gtsam.noiseModel.Robust.Create(gtsam.noiseModel.mEstimator.Cauchy.Create(self.p.odom_robust_k), g)
+        if self.p.odom_robust == "huber":
+            return gtsam.noiseModel.Robust.Create(gtsam.noiseModel.mEstimator.Huber.Create(self.p.odom_robust_k), g)
+        if self.p.odom_robust not in ("none", "gaussian"):
+            raise ValueError(f"unknown robust kernel {self.p.odom_robust!r}")
+        return g
+
     def _obs_noise(self, cov_rb):
         g = gtsam.noiseModel.Gaussian.Covariance(to_gtsam_cov(cov_rb))
         if self.p.robust == "huber":
             return gtsam.noiseModel.Robust.Create(gtsam.noiseModel.mEstimator.Huber.Create(self.p.huber_k), g)
-        if self.p.robust != "none":
+        if self.p.robust == "cauchy":
+            return gtsam.noiseModel.Robust.Create(gtsam.noiseModel.mEstimator.Cauchy.Create(self.p.huber_k), g)
+        if self.p.robust not in ("none", "gaussian"):
             raise ValueError(f"unknown robust kernel {self.p.robust!r}")
         return g
 
@@ -245,8 +259,7 @@ class Slam:
             if i > 0:
                 if s.odom is None:
                     raise ValueError(f"step {i} has no odometry")
-                nm = gtsam.noiseModel.Gaussian.Covariance(np.asarray(s.odom_cov, float))
-                f = gtsam.BetweenFactorPose2(X(i - 1), X(i), gtsam.Pose2(*s.odom), nm)
+                f = gtsam.BetweenFactorPose2(X(i - 1), X(i), gtsam.Pose2(*s.odom), self._odom_noise(s.odom_cov))
                 graph.add(f)
                 new_f.add(f)
                 cur = compose(cur, s.odom)

@@ -20,6 +20,7 @@ import numpy as np
 
 EXIT_OK, EXIT_CHECK, EXIT_USAGE, EXIT_INPUT, EXIT_OUTPUT = 0, 1, 2, 3, 4
 FIXED_GRID = (0.25, 0.5, 1.0, 2.0, 4.0)
+DEFAULT_NOISE_MODEL = os.path.join(os.path.dirname(os.path.abspath(__file__)), "models", "mrclam_noise.json")
 
 
 class Progress:
@@ -313,9 +314,11 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
     g.add_argument("--init-max-sigma", type=float, default=0.5,
                    help="m, no new landmark from an observation whose planar sigma is larger "
                         "(default %(default)s)")
-    g.add_argument("--robust", choices=["none", "huber"], default=robust_default,
-                   help="robust kernel on observation factors (default %(default)s)")
-    g.add_argument("--huber-k", type=float, default=1.345, help="Huber threshold (default %(default)s)")
+    g.add_argument("--robust", choices=["none", "huber", "cauchy"], default=robust_default,
+                   help="robust kernel on observation factors (default " +
+                        (robust_default or "the learned noise model's with --noise learned, else huber") + ")")
+    g.add_argument("--huber-k", "--robust-k", dest="huber_k", type=float, default=1.345,
+                   help="the kernel's threshold on the whitened residual (default %(default)s)")
     g.add_argument("--anchor", choices=["truth", "origin"], default="truth",
                    help="gauge: first pose at the true start pose when known, else origin "
                         "(default %(default)s)")
@@ -411,12 +414,23 @@ def check_synthetic(s):
 
 def cmd_mrclam(args):
     from .mrclam import MrclamError, read_mrclam
+    from .noise_model import NoiseModel, NoiseModelError
     robots = [1, 2, 3, 4, 5] if args.robot == "all" else [int(args.robot)]
     rows = []
+    model = None
+    if args.noise == "learned":
+        try:
+            model = NoiseModel.load(args.noise_model)
+        except NoiseModelError as e:
+            print(f"cylslam: error: {e}", file=sys.stderr)
+            return EXIT_INPUT
+    if args.robust is None:   # the learned model's kernel, else Huber
+        args.robust, args.huber_k = ((model.kernel if model.kernel != "gaussian" else "none", model.kernel_k or 1.0)
+                                     if model else ("huber", args.huber_k))
     for rb in robots:
         try:
             ds = read_mrclam(args.dir, rb, duration=args.duration, noise=args.noise,
-                             odom_scale=args.odom_scale)
+                             odom_scale=args.odom_scale, model=model)
         except MrclamError as e:
             print(f"cylslam: error: {e}", file=sys.stderr)
             return EXIT_INPUT
@@ -429,7 +443,9 @@ def cmd_mrclam(args):
         rows.append((rb, s))
     print()
     print(f"MRCLAM {os.path.basename(os.path.normpath(args.dir))}, {args.assoc} association, "
-          f"noise {args.noise}, robust {args.robust}, odometry sigmas x{args.odom_scale:g}")
+          f"noise {args.noise}" + (f" ({args.noise_model})" if model else "") +
+          f", robust {args.robust}" + (f" k {args.huber_k:.3g}" if args.robust != "none" else "") +
+          f", odometry sigmas x{args.odom_scale:g}")
     print("| robot | duration s | poses | obs used | RMSE aligned m | RMSE unaligned m | "
           "dead reckoning unaligned m | landmark RMSE m | ANEES lm | ANEES poses | assoc. errors | "
           "fixed-cov RMSE m | time s |")
@@ -460,6 +476,55 @@ def cmd_mrclam(args):
     agg["robots"] = per
     print(json.dumps(_r(agg, 4)))
     return rc
+
+
+def cmd_mrclam_noise(args):
+    from .mrclam import MrclamError, read_mrclam
+    from . import noise_model as nm
+    try:
+        robots = [int(x) for x in args.robots.split(",")]
+    except ValueError:
+        print(f"cylslam: error: --robots: expected numbers separated by commas, got {args.robots!r}", file=sys.stderr)
+        return EXIT_USAGE
+    try:
+        by_robot = {rb: read_mrclam(args.dir, rb) for rb in sorted(set(robots) | ({1, 2, 3, 4, 5}
+                                                                                  if not args.no_cross_check else set()))}
+        model, rep = nm.fit([by_robot[r] for r in robots],
+                            f"{os.path.basename(os.path.normpath(args.dir))}, robots {','.join(map(str, robots))}")
+    except (MrclamError, nm.NoiseModelError) as e:
+        print(f"cylslam: error: {e}", file=sys.stderr)
+        return EXIT_INPUT
+    print(f"{len(rep['residuals'])} measurement residuals, {len(rep['odometry_residuals'])} odometry steps")
+    print("| measurement kernel | a_r m | b_r | a_b rad | b_b rad m | k | BIC |")
+    print("|---|---|---|---|---|---|---|")
+    for k, v in rep["measurement"].items():
+        kk = "-" if v["kernel_k"] is None else f"{v['kernel_k']:.3f}"
+        print(f"| {k}{' (chosen)' if k == rep['chosen'] else ''} | {v['a_r_m']:.4f} | {v['b_r']:.4f} | "
+              f"{v['a_b_rad']:.5f} | {v['b_b_rad_m']:.5f} | {kk} | {v['bic']:.1f} |")
+    print("| odometry component | k_t (per sqrt s) | k_d (per m) | k_a (per rad) |")
+    print("|---|---|---|---|")
+    for c in ("x", "y", "theta"):
+        o = model.odom[c]
+        print(f"| {c} | {o['k_t']:.3g} | {o['k_d']:.3g} | {o['k_a']:.3g} |")
+    own = nm.check(model, [by_robot[r] for r in robots])
+    print("on the fitting data:", json.dumps(_r(own, 3)))
+    summary = {"kernel": model.kernel, "kernel_k": model.kernel_k, **{k: model.meas[k] for k in model.meas},
+               "fit_check": own}
+    if not args.no_cross_check:
+        cc = nm.cross_check(by_robot, [((1, 3, 5), (2, 4)), ((2, 4), (1, 3, 5))])
+        summary["held_out"] = []
+        for train, test, m2, ch in cc:
+            print(f"fit on robots {train} ({m2.kernel}), judged on {test}:", json.dumps(_r(ch, 3)))
+            summary["held_out"].append({"train": train, "test": test, **ch})
+    if args.out:
+        try:
+            model.save(args.out)
+        except nm.NoiseModelError as e:
+            print(f"cylslam: error: {e}", file=sys.stderr)
+            return EXIT_OUTPUT
+        print(f"wrote {args.out}")
+    print(json.dumps(_r(summary, 4)))
+    return EXIT_OK
 
 
 def cmd_victoria(args):
@@ -530,17 +595,35 @@ def build_parser():
                     help="data set directory (default $MRCLAM_DIR or %(default)s)")
     sp.add_argument("--robot", default="all", help="1-5 or all (default %(default)s)")
     sp.add_argument("--duration", type=float, default=None, help="only the first S seconds")
-    sp.add_argument("--noise", choices=["range", "fixed"], default="range",
-                    help="measurement noise model: range-dependent sigma_r = 0.03 r + 0.02 m, or "
-                         "fixed sigma_r = 0.1 m; sigma_b = 0.01 rad (default %(default)s)")
+    sp.add_argument("--noise", choices=["range", "fixed", "learned"], default="range",
+                    help="noise model: range-dependent sigma_r = 0.03 r + 0.02 m, or fixed sigma_r = 0.1 m, "
+                         "both with sigma_b = 0.01 rad and the reader's odometry sigmas; or learned: "
+                         "measurement and odometry sigmas and the measurement kernel from --noise-model "
+                         "(default %(default)s)")
+    sp.add_argument("--noise-model", default=DEFAULT_NOISE_MODEL,
+                    help="a model written by `mrclam-noise` (default: the one fitted on Dataset 7, "
+                         "%(default)s)")
     sp.add_argument("--odom-scale", type=float, default=1.0,
                     help="multiply the odometry sigmas by this (default %(default)s)")
     sp.add_argument("--check-rmse", type=float, default=None,
                     help="exit 1 unless every robot's aligned RMSE is <= this")
     sp.add_argument("--check-time", type=float, default=None,
                     help="with --check-rmse: exit 1 if a robot's run takes longer (s)")
-    add_common(sp, assoc_default="known", robust_default="huber", fixed_default="mean")
+    add_common(sp, assoc_default="known", robust_default=None, fixed_default="mean")
     sp.set_defaults(func=cmd_mrclam)
+
+    sp = sub.add_parser("mrclam-noise", help="learn the range/bearing and odometry noise from MRCLAM truth",
+                        description="Fit the noise model (cylslam/noise_model.py) on the residuals of "
+                                    "an MRCLAM data set against its Vicon truth: sigmas as functions of "
+                                    "range and motion, the measurement kernel chosen by BIC; then check "
+                                    "it on held-out robots (fit on 1,3,5, judge on 2,4, and the reverse). "
+                                    "Last stdout line: JSON.")
+    sp.add_argument("--dir", default=os.environ.get("MRCLAM_DIR", "../shared/data/mrclam/MRCLAM_Dataset7"),
+                    help="data set directory (default $MRCLAM_DIR or %(default)s)")
+    sp.add_argument("--out", default=None, help="write the model (JSON) here")
+    sp.add_argument("--robots", default="1,2,3,4,5", help="robots to fit on (default %(default)s)")
+    sp.add_argument("--no-cross-check", action="store_true", help="skip the held-out robot check")
+    sp.set_defaults(func=cmd_mrclam_noise)
 
     sp = sub.add_parser("victoria", help="SLAM on gtsam's Victoria Park file (no truth)",
                         description="Reads victoria_park.txt with gtsam.load2D (the copy in the "

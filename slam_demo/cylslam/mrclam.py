@@ -127,7 +127,9 @@ def interp_truth(gt, tq, max_gap=0.25):
 
 
 def read_mrclam(directory, robot, duration=None, keyframe_dt=0.5, noise="range",
-                max_gap=0.25, merge_dt=0.05, odom_scale=1.0) -> Dataset:
+                max_gap=0.25, merge_dt=0.05, odom_scale=1.0, model=None) -> Dataset:
+    """`model`: a noise_model.NoiseModel for the measurement and odometry covariances (then
+    `noise` is not used), or None for the fixed models of the module text."""
     d = directory
     for f in ("Barcodes.dat", "Landmark_Groundtruth.dat", f"Robot{robot}_Odometry.dat",
               f"Robot{robot}_Measurement.dat", f"Robot{robot}_Groundtruth.dat"):
@@ -183,13 +185,17 @@ def read_mrclam(directory, robot, duration=None, keyframe_dt=0.5, noise="range",
         s = Step(t=float(t), seq=k, truth=None if np.isnan(truth[k, 0]) else truth[k])
         if k > 0:
             inc = between(dr[k - 1], dr[k])
-            sx, sy, st = (odom_scale * v for v in odom_sigmas(inc, t - times[k - 1]))
+            if model is not None:
+                s.odom_cov = odom_scale ** 2 * model.odom_cov(inc, t - times[k - 1])
+            else:
+                sx, sy, st = (odom_scale * v for v in odom_sigmas(inc, t - times[k - 1]))
+                s.odom_cov = np.diag([sx * sx, sy * sy, st * st])
             s.odom = inc
-            s.odom_cov = np.diag([sx * sx, sy * sy, st * st])
         steps.append(s)
     for n_line, (t, s, r, br) in enumerate(keep):
         steps[step_of[t]].obs.append(Obs(cls="barcode", range_m=float(r), bearing_rad=float(br),
-                                     cov=meas_cov(r, noise), lm_id=int(s),
+                                     cov=model.meas_cov(r) if model is not None else meas_cov(r, noise),
+                                     lm_id=int(s),
                                      where=f"Robot{robot}_Measurement.dat t={t:.3f}"))
     tl = {int(s): (float(x), float(y), "barcode") for s, x, y in lmgt}
     ds = Dataset(name=f"MRCLAM Dataset robot {robot}", steps=steps, truth_landmarks=tl,

@@ -20,7 +20,7 @@ def _cli(*args):
                           text=True, env=ENV, timeout=120)
 
 
-@pytest.mark.parametrize("cmd", ["run", "synth", "mrclam", "victoria", "excerpt"])
+@pytest.mark.parametrize("cmd", ["run", "synth", "mrclam", "mrclam-noise", "victoria", "excerpt"])
 def test_help(cmd):
     r = _cli(cmd, "--help")
     assert r.returncode == 0 and "usage:" in r.stdout
