@@ -37,7 +37,7 @@ slam-synth: $(VENV)/.stamp
 	$(CYLSLAM) run $(SLAM_OUT)/synth.jsonl --out $(SLAM_OUT)/synth --check
 
 mrclam: $(VENV)/.stamp
-	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc known --out $(SLAM_OUT)/mrclam-known \
+	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc known --multi --out $(SLAM_OUT)/mrclam-known \
 	  --check-rmse 0.15 --check-time 30
 	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc unknown --odom-scale 4 --out $(SLAM_OUT)/mrclam-unknown
 	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc known --noise learned --out $(SLAM_OUT)/mrclam-known-learned

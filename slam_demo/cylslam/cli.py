@@ -474,8 +474,65 @@ def cmd_mrclam(args):
     agg["time_s"] = max(s["stats"]["t_total_s"] for _, s in rows)
     agg["worst_robot"] = max(rows, key=lambda r: r[1]["ate_m"])[0]
     agg["robots"] = per
+    if args.multi:
+        agg.update(multi_robot(args, model, robots))
+        if args.check_rmse is not None:
+            if not agg["multi_aligned_rmse_max_m"] <= args.check_rmse:
+                print(f"CHECK FAILED: one map: a robot's RMSE in the joint frame is "
+                      f"{agg['multi_aligned_rmse_max_m']:.3f} m > {args.check_rmse} m")
+                rc = EXIT_CHECK
+            else:
+                print(f"checks passed: one map: every robot's RMSE in the joint frame <= {args.check_rmse} m")
     print(json.dumps(_r(agg, 4)))
     return rc
+
+
+def multi_robot(args, model, robots):
+    """All robots in one graph with shared landmarks (cylslam/multi.py); prints a table and returns
+    the multi_* keys of the last line."""
+    from .mrclam import read_mrclam
+    from .multi import evaluate_multi, run_multi
+    dss = [read_mrclam(args.dir, rb, duration=args.duration, noise=args.noise, odom_scale=args.odom_scale,
+                       model=model) for rb in robots]
+    res = run_multi(dss, robots, _params(args, assoc="known"), progress=Progress("one map", args.progress))
+    for n in res.notes:
+        print(f"note: {n}")
+    m = evaluate_multi(dss, robots, res)
+    print()
+    print(f"One map from robots {','.join(map(str, res.robots))} (known association, shared landmarks, start "
+          f"poses of robots after the first unknown): {res.stats['poses']} poses, "
+          f"{res.stats['observations_used']} observations, {res.stats['landmarks']} landmarks, "
+          f"{res.stats['t_total_s']:.1f} s")
+    print("| robot | RMSE in the joint frame m | RMSE aligned alone m | RMSE unaligned m | joint ANEES poses |")
+    print("|---|---|---|---|---|")
+    for lab in res.robots:
+        r = m["robots"][str(lab)]
+        print(f"| {lab} | {r['aligned_rmse_joint_frame_m']:.3f} | {r['own_aligned_rmse_m']:.3f} | "
+              f"{r['unaligned_rmse_m']:.3f} | {r['anees_poses_joint']:.2f} |")
+    print(f"landmarks: RMSE {m.get('landmark_rmse_aligned_m', math.nan):.3f} m in the joint frame "
+          f"({m.get('landmark_rmse_m', math.nan):.3f} m unaligned), ANEES {m.get('anees_landmarks', math.nan):.2f}, "
+          f"joint ANEES {m.get('anees_landmarks_joint', math.nan):.2f}")
+    if args.out:
+        os.makedirs(args.out, exist_ok=True)
+        with open(os.path.join(args.out, "one_map.json"), "w") as fh:
+            json.dump(_r({"stats": res.stats, "notes": res.notes, **m}, 6), fh, indent=1)
+        with open(os.path.join(args.out, "one_map_landmarks.csv"), "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["id", "x_m", "y_m", "cov_xx", "cov_xy", "cov_yy"])
+            for i in sorted(res.lms):
+                c = res.lm_cov[i]
+                w.writerow([i, f"{res.lms[i][0]:.6f}", f"{res.lms[i][1]:.6f}", f"{c[0, 0]:.6g}", f"{c[0, 1]:.6g}",
+                            f"{c[1, 1]:.6g}"])
+        for lab in res.robots:
+            with open(os.path.join(args.out, f"one_map_robot{lab}.tum"), "w") as fh:
+                ds = dss[robots.index(lab)]
+                for st, q in zip(ds.steps, res.poses[lab]):
+                    fh.write(_tum_line(st.t, *q))
+    per = [m["robots"][str(lab)]["aligned_rmse_joint_frame_m"] for lab in res.robots]
+    return {"multi_robots": res.robots, "multi_aligned_rmse_max_m": max(per),
+            "multi_landmark_rmse_m": m.get("landmark_rmse_aligned_m"),
+            "multi_landmark_rmse_unaligned_m": m.get("landmark_rmse_m"),
+            "multi_anees_landmarks": m.get("anees_landmarks"), "multi_time_s": res.stats["t_total_s"]}
 
 
 def cmd_mrclam_noise(args):
@@ -605,8 +662,12 @@ def build_parser():
                          "%(default)s)")
     sp.add_argument("--odom-scale", type=float, default=1.0,
                     help="multiply the odometry sigmas by this (default %(default)s)")
+    sp.add_argument("--multi", action="store_true",
+                    help="also map all the robots together: one graph, shared landmarks, the start poses "
+                         "of all robots but the first unknown (known association)")
     sp.add_argument("--check-rmse", type=float, default=None,
-                    help="exit 1 unless every robot's aligned RMSE is <= this")
+                    help="exit 1 unless every robot's aligned RMSE is <= this (with --multi: in the joint "
+                         "frame too)")
     sp.add_argument("--check-time", type=float, default=None,
                     help="with --check-rmse: exit 1 if a robot's run takes longer (s)")
     add_common(sp, assoc_default="known", robust_default=None, fixed_default="mean")

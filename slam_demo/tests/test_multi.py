@@ -1,0 +1,68 @@
+# SPDX-License-Identifier: BSD-3-Clause
+"""One map from several robots: the rigid fit, and two "robots" cut from the MRCLAM fixture (the
+first and second half of robot 2's excerpt; the second's start pose unknown to the graph)."""
+import dataclasses
+import math
+import os
+
+import numpy as np
+import pytest
+
+from conftest import FIXTURES
+from cylslam import metrics, mrclam
+from cylslam.backend import Params, Slam
+from cylslam.data import Dataset
+from cylslam.multi import evaluate_multi, rigid_fit, run_multi
+
+MR = os.path.join(FIXTURES, "mrclam")
+
+
+def test_rigid_fit_recovers_a_rotation_and_translation():
+    rng = np.random.default_rng(2)
+    src = rng.uniform(-5, 5, (6, 2))
+    a = 0.7
+    R = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+    t = np.array([1.5, -2.0])
+    Rf, tf = rigid_fit(src, src @ R.T + t)
+    assert np.allclose(Rf, R) and np.allclose(tf, t)
+    # a reflection is never returned
+    Rf, _ = rigid_fit(src, src * [1, -1])
+    assert np.linalg.det(Rf) == pytest.approx(1.0)
+
+
+def _halves(ds, k):
+    a = Dataset(name="A", steps=ds.steps[:k], truth_landmarks=ds.truth_landmarks, classes=ds.classes, known_ids=True)
+    rest = [dataclasses.replace(s) for s in ds.steps[k:]]
+    rest[0] = dataclasses.replace(rest[0], odom=None, odom_cov=None)
+    b = Dataset(name="B", steps=rest, truth_landmarks=ds.truth_landmarks, classes=ds.classes, known_ids=True)
+    return a, b
+
+
+def test_two_robots_one_map_places_the_second_by_shared_landmarks():
+    ds = mrclam.read_mrclam(MR, 2)
+    a, b = _halves(ds, len(ds.steps) // 2)
+    p = Params(assoc="known", robust="huber")
+    res = run_multi([a, b], ["A", "B"], p)
+    assert res.robots == ["A", "B"] and not res.notes
+    m = evaluate_multi([a, b], ["A", "B"], res)
+    # robot B's start is nowhere in the graph but it lands in the joint frame: its positions are as
+    # close to truth as robot A's, and as those of the whole excerpt mapped as one robot
+    single = metrics.evaluate(ds, Slam(p).run(ds))
+    for lab in ("A", "B"):
+        assert m["robots"][lab]["aligned_rmse_joint_frame_m"] < 0.15
+    assert m["joint_aligned_rmse_m"] == pytest.approx(single["ate_m"], abs=0.03)
+    # landmarks: the excerpt as one robot 0.131 m, as two robots 0.200 m (each half's map less certain)
+    assert m["landmark_rmse_aligned_m"] < single["landmark_rmse_aligned_m"] + 0.1
+    # the second robot's start, never given, is found within 0.2 m of its true pose
+    start_b = res.poses["B"][0]
+    assert math.hypot(*(start_b[:2] - b.steps[0].truth[:2])) < 0.2 + m["joint_aligned_rmse_m"]
+
+
+def test_a_robot_sharing_no_landmark_is_left_out_with_a_note():
+    ds = mrclam.read_mrclam(MR, 2)
+    a, b = _halves(ds, len(ds.steps) // 2)
+    steps = [dataclasses.replace(s, obs=[dataclasses.replace(o, lm_id=o.lm_id + 100) for o in s.obs]) for s in b.steps]
+    b = dataclasses.replace(b, steps=steps)
+    res = run_multi([a, b], ["A", "B"], Params(assoc="known", robust="huber"))
+    assert res.robots == ["A"]
+    assert any("B: shares 0 landmark(s)" in n for n in res.notes)
