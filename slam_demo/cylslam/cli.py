@@ -543,10 +543,11 @@ def cmd_mrclam_noise(args):
     except ValueError:
         print(f"cylslam: error: --robots: expected numbers separated by commas, got {args.robots!r}", file=sys.stderr)
         return EXIT_USAGE
+    def read_robot(rb, mdl):
+        return read_mrclam(args.dir, rb, model=mdl)
+
     try:
-        by_robot = {rb: read_mrclam(args.dir, rb) for rb in sorted(set(robots) | ({1, 2, 3, 4, 5}
-                                                                                  if not args.no_cross_check else set()))}
-        model, rep = nm.fit([by_robot[r] for r in robots],
+        model, rep = nm.fit(lambda mdl: [read_robot(r, mdl) for r in robots],
                             f"{os.path.basename(os.path.normpath(args.dir))}, robots {','.join(map(str, robots))}")
     except (MrclamError, nm.NoiseModelError) as e:
         print(f"cylslam: error: {e}", file=sys.stderr)
@@ -558,17 +559,22 @@ def cmd_mrclam_noise(args):
         kk = "-" if v["kernel_k"] is None else f"{v['kernel_k']:.3f}"
         print(f"| {k}{' (chosen)' if k == rep['chosen'] else ''} | {v['a_r_m']:.4f} | {v['b_r']:.4f} | "
               f"{v['a_b_rad']:.5f} | {v['b_b_rad_m']:.5f} | {kk} | {v['bic']:.1f} |")
+    print(f"odometry: a command acts {model.cmd_delay_s:.3f} s after its stamp; the robots drive "
+          f"{model.cmd_scale[0]:.3f} and turn {model.cmd_scale[1]:.3f} times what they are commanded (the "
+          "commands are shifted and scaled so before integration)")
     print("| odometry component | k_t (per sqrt s) | k_d (per m) | k_a (per rad) |")
     print("|---|---|---|---|")
     for c in ("x", "y", "theta"):
         o = model.odom[c]
         print(f"| {c} | {o['k_t']:.3g} | {o['k_d']:.3g} | {o['k_a']:.3g} |")
-    own = nm.check(model, [by_robot[r] for r in robots])
+    own = nm.check(model, rep["datasets"])
     print("on the fitting data:", json.dumps(_r(own, 3)))
     summary = {"kernel": model.kernel, "kernel_k": model.kernel_k, **{k: model.meas[k] for k in model.meas},
+               "speed_scale": model.cmd_scale[0], "turn_scale": model.cmd_scale[1],
+               "command_delay_s": model.cmd_delay_s,
                "fit_check": own}
     if not args.no_cross_check:
-        cc = nm.cross_check(by_robot, [((1, 3, 5), (2, 4)), ((2, 4), (1, 3, 5))])
+        cc = nm.cross_check(read_robot, [((1, 3, 5), (2, 4)), ((2, 4), (1, 3, 5))])
         summary["held_out"] = []
         for train, test, m2, ch in cc:
             print(f"fit on robots {train} ({m2.kernel}), judged on {test}:", json.dumps(_r(ch, 3)))

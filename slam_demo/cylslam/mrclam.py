@@ -142,6 +142,13 @@ def read_mrclam(directory, robot, duration=None, keyframe_dt=0.5, noise="range",
     meas = _load(os.path.join(d, f"Robot{robot}_Measurement.dat"), 4)
     gt = _load(os.path.join(d, f"Robot{robot}_Groundtruth.dat"), 4)
     odo = odo[np.argsort(odo[:, 0], kind="stable")]
+    if model is not None and (model.cmd_scale != (1.0, 1.0) or model.cmd_delay_s != 0.0):
+        # the robots act on a command some time after its stamp and move and turn less than
+        # commanded (noise_model.py)
+        odo = odo.copy()
+        odo[:, 0] += model.cmd_delay_s
+        odo[:, 1] *= model.cmd_scale[0]
+        odo[:, 2] *= model.cmd_scale[1]
     t0 = odo[0, 0]
     t_end = odo[-1, 0] if duration is None else min(odo[-1, 0], t0 + duration)
     notes = []

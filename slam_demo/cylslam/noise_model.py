@@ -113,7 +113,7 @@ class NoiseModel:
     """sigma_r(r), sigma_b(r), the kernel, and the odometry sigmas (see the module text)."""
 
     def __init__(self, meas, odom, kernel="gaussian", kernel_k=None, odom_kernel="gaussian", odom_kernel_k=None,
-                 provenance=None):
+                 provenance=None, cmd_scale=(1.0, 1.0), cmd_delay_s=0.0):
         self.meas = dict(meas)        # a_r_m, b_r, a_b_rad, b_b_rad_m
         self.odom = {c: dict(v) for c, v in odom.items()}   # x, y, theta: k_t, k_d, k_a
         self.kernel = kernel          # of the measurement factors
@@ -121,6 +121,8 @@ class NoiseModel:
         self.odom_kernel = odom_kernel
         self.odom_kernel_k = odom_kernel_k
         self.provenance = provenance or {}
+        self.cmd_scale = tuple(float(x) for x in cmd_scale)   # (speed, turn rate): true / commanded
+        self.cmd_delay_s = float(cmd_delay_s)                   # a command acts this long after its stamp
 
     def sigmas_rb(self, r):
         m = self.meas
@@ -141,7 +143,9 @@ class NoiseModel:
     def to_json(self):
         return {"format": FORMAT, "version": VERSION,
                 "measurement": {**self.meas, "kernel": self.kernel, "kernel_k": self.kernel_k},
-                "odometry": {**self.odom, "kernel": self.odom_kernel, "kernel_k": self.odom_kernel_k},
+                "odometry": {**self.odom, "kernel": self.odom_kernel, "kernel_k": self.odom_kernel_k,
+                             "speed_scale": self.cmd_scale[0], "turn_scale": self.cmd_scale[1],
+                             "command_delay_s": self.cmd_delay_s},
                 "provenance": self.provenance}
 
     def save(self, path):
@@ -171,7 +175,12 @@ class NoiseModel:
         m = j["measurement"]
         keys(m, ["a_r_m", "b_r", "a_b_rad", "b_b_rad_m", "kernel", "kernel_k"], "measurement")
         o = j["odometry"]
-        keys(o, ["x", "y", "theta", "kernel", "kernel_k"], "odometry")
+        keys(o, ["x", "y", "theta", "kernel", "kernel_k", "speed_scale", "turn_scale", "command_delay_s"], "odometry")
+        if not isinstance(o["command_delay_s"], (int, float)) or not -2.0 <= o["command_delay_s"] <= 2.0:
+            raise NoiseModelError(f"{path}: odometry.command_delay_s: expected a number in -2..2")
+        for k in ("speed_scale", "turn_scale"):
+            if not isinstance(o[k], (int, float)) or not 0.2 <= o[k] <= 5.0:
+                raise NoiseModelError(f"{path}: odometry.{k}: expected a number in 0.2-5")
         kernels = {}
         for where, obj in (("measurement", m), ("odometry", o)):
             if obj["kernel"] not in KERNELS:
@@ -195,7 +204,8 @@ class NoiseModel:
             meas[k] = float(m[k])
         if meas["a_r_m"] == 0 or meas["a_b_rad"] == 0:
             raise NoiseModelError(f"{path}: measurement: a_r_m and a_b_rad must be > 0")
-        return NoiseModel(meas, odom, *kernels["measurement"], *kernels["odometry"], j["provenance"])
+        return NoiseModel(meas, odom, *kernels["measurement"], *kernels["odometry"], j["provenance"],
+                          (float(o["speed_scale"]), float(o["turn_scale"])), float(o["command_delay_s"]))
 
 
 def write_text_safely(path, text):
@@ -348,8 +358,66 @@ def fit_odometry(O, kernels=KERNELS):
     return out, chosen
 
 
-def fit(datasets, source):
-    """Fit the model on the data sets (each a Dataset with truth). Returns (NoiseModel, report)."""
+def command_scales(datasets):
+    """(speed, turn) scales: least-squares ratios of the true to the odometry forward and heading
+    increments over all steps with truth (the robots drive and turn less than commanded)."""
+    xo = xt = ao = at = 0.0
+    for ds in datasets:
+        st = ds.steps
+        for k in range(1, len(st)):
+            if st[k - 1].truth is None or st[k].truth is None or st[k].odom is None:
+                continue
+            tr = between(st[k - 1].truth, st[k].truth)
+            xo += st[k].odom[0] ** 2
+            xt += st[k].odom[0] * tr[0]
+            ao += st[k].odom[2] ** 2
+            at += st[k].odom[2] * tr[2]
+    return xt / xo, at / ao
+
+
+def _odometry_only(scales=(1.0, 1.0), delay=0.0):
+    return NoiseModel({"a_r_m": 1.0, "b_r": 0.0, "a_b_rad": 1.0, "b_b_rad_m": 0.0},
+                      {c: {"k_t": 0.0, "k_d": 0.0, "k_a": 0.0} for c in ("x", "y", "theta")},
+                      cmd_scale=scales, cmd_delay_s=delay)
+
+
+def heading_rms(datasets, scale):
+    """RMS of the per-step heading increment error with the turn rate scaled (rad)."""
+    e = [between(st[k - 1].truth, st[k].truth)[2] - scale * st[k].odom[2]
+         for ds in datasets for st in [ds.steps] for k in range(1, len(st))
+         if st[k - 1].truth is not None and st[k].truth is not None and st[k].odom is not None]
+    return float(np.sqrt(np.mean(np.square(e))))
+
+
+def command_delay(read, lo=0.0, hi=0.6):
+    """The delay (s) between a command's stamp and its effect that minimises the heading
+    increment error (with the least-squares turn scale at each delay): golden-section search."""
+    def f(d):
+        ds = read(_odometry_only(delay=d))
+        return heading_rms(ds, command_scales(ds)[1])
+
+    g = (math.sqrt(5.0) - 1.0) / 2.0
+    a, b = lo, hi
+    c, d = b - g * (b - a), a + g * (b - a)
+    fc, fd = f(c), f(d)
+    while b - a > 0.005:
+        if fc < fd:
+            b, d, fd = d, c, fc
+            c = b - g * (b - a)
+            fc = f(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + g * (b - a)
+            fd = f(d)
+    return round((a + b) / 2.0, 3)
+
+
+def fit(read, source):
+    """Fit the model. `read(model_or_None)` returns the data sets (with truth) read with that
+    model's command delay and scales (None: as recorded). Returns (NoiseModel, report)."""
+    delay = command_delay(read)
+    scales = command_scales(read(_odometry_only(delay=delay)))
+    datasets = read(_odometry_only(scales, delay))
     R = np.vstack([measurement_residuals(ds) for ds in datasets])
     O = np.vstack([odometry_residuals(ds) for ds in datasets])
     if len(R) < 50 or len(O) < 50:
@@ -361,11 +429,13 @@ def fit(datasets, source):
     prov = {"source": source, "measurements": int(len(R)), "odometry_steps": int(len(O)),
             "measurement_kernel_bic": {k: round(v["bic"], 1) for k, v in per.items()},
             "odometry_kernel_bic": {k: round(v["bic"], 1) for k, v in per_o.items()},
-            "procedure": "maximum likelihood against ground truth, kernel by BIC (cylslam/noise_model.py)"}
+            "procedure": "command delay by golden-section search and command scales by least squares on the "
+                         "heading and forward increments, then maximum likelihood against ground truth, "
+                         "measurement kernel by BIC (cylslam/noise_model.py)"}
     model = NoiseModel(meas, per_o[chosen_o]["model"], chosen, c["kernel_k"], chosen_o, per_o[chosen_o]["kernel_k"],
-                       prov)
+                       prov, scales, delay)
     return model, {"measurement": per, "chosen": chosen, "odometry": per_o, "chosen_odometry": chosen_o,
-                   "residuals": R, "odometry_residuals": O}
+                   "residuals": R, "odometry_residuals": O, "datasets": datasets}
 
 
 def radius(kernel, k, p, dim=2):
@@ -410,10 +480,11 @@ def check(model, datasets):
     return out
 
 
-def cross_check(by_robot, splits):
-    """Fit on some robots, check on the others: [(train, test, kernel, check dict)]."""
+def cross_check(read_robot, splits):
+    """Fit on some robots, check on the others: [(train, test, model, check dict)].
+    read_robot(robot, model_or_None) reads one robot."""
     out = []
     for train, test in splits:
-        m, _ = fit([by_robot[r] for r in train], f"robots {train}")
-        out.append((list(train), list(test), m, check(m, [by_robot[r] for r in test])))
+        m, _ = fit(lambda mdl: [read_robot(r, mdl) for r in train], f"robots {train}")
+        out.append((list(train), list(test), m, check(m, [read_robot(r, m) for r in test])))
     return out

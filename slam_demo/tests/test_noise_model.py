@@ -14,6 +14,7 @@ import pytest
 
 from conftest import FIXTURES, HERE
 from cylslam import noise_model as nm
+from cylslam import mrclam
 from cylslam.mrclam import read_mrclam
 
 MR = os.path.join(FIXTURES, "mrclam")
@@ -152,3 +153,40 @@ def test_cli_fits_on_the_fixture_and_maps_with_the_model(tmp_path):
     assert json.loads(r.stdout.strip().splitlines()[-1])["association_errors"] == 0
     r = _cli("mrclam", "--dir", MR, "--robot", "2", "--noise", "learned", "--noise-model", str(tmp_path / "none.json"))
     assert r.returncode == 3 and "none.json" in r.stderr
+
+
+def _drive(delay_true, scale_true):
+    """A read(model) for command_delay / fit: velocity commands every 0.1 s (random, held), the
+    robot executing them `delay_true` s late and scaled by `scale_true`; the odometry integrated
+    from the commands as the model says (its delay and scales)."""
+    from cylslam.data import Dataset, Step, between
+    rng = np.random.default_rng(4)
+    t = np.arange(0.0, 120.0, 0.1)
+    v = np.repeat(rng.uniform(0.0, 0.3, len(t) // 10), 10)
+    w = np.repeat(rng.uniform(-0.8, 0.8, len(t) // 10), 10)
+    steps_t = np.arange(1.0, 118.0, 0.5)
+
+    def poses(delay, sv, sw):
+        odo = np.stack([t + delay, v * sv, w * sw], 1)
+        return mrclam.dr_at(odo, mrclam.integrate(odo), steps_t)
+
+    truth = poses(delay_true, *scale_true)
+
+    def read(model):
+        d, s = (model.cmd_delay_s, model.cmd_scale) if model is not None else (0.0, (1.0, 1.0))
+        dr = poses(d, *s)
+        steps = [Step(t=float(steps_t[0]), seq=0, truth=truth[0])]
+        for k in range(1, len(steps_t)):
+            steps.append(Step(t=float(steps_t[k]), seq=k, truth=truth[k], odom=between(dr[k - 1], dr[k]),
+                              odom_cov=np.eye(3)))
+        return [Dataset(name="drive", steps=steps)]
+
+    return read
+
+
+def test_command_delay_and_scales_are_recovered():
+    read = _drive(0.2, (0.9, 0.8))
+    d = nm.command_delay(read)
+    assert d == pytest.approx(0.2, abs=0.01)
+    sv, sw = nm.command_scales(read(nm._odometry_only(delay=d)))
+    assert sv == pytest.approx(0.9, abs=0.01) and sw == pytest.approx(0.8, abs=0.01)
