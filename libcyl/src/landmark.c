@@ -93,18 +93,32 @@ cyl_status cyl_landmark_models_check(const cyl_landmark_model *models, uint32_t 
     return CYL_OK;
 }
 
-static void model_geom(const cyl_landmark_model *m, band_geom *g)
+double cyl_landmark_height_m(const cyl_landmark_model *m)
 {
-    double total = 0.0, below = 0.0;
+    double total = 0.0;
     int k;
     for (k = 0; k < m->n_bands; k++) total += m->band_height_m[k];
+    return total;
+}
+
+double cyl_landmark_diameter_at_m(const cyl_landmark_model *m, double z_m)
+{
+    const double total = cyl_landmark_height_m(m);
+    double f;
+    if (m->shape != CYL_SHAPE_CONE || !(total > 0.0)) return m->diameter_bottom_m;
+    f = z_m / total;
+    if (f < 0.0) f = 0.0;
+    if (f > 1.0) f = 1.0;
+    return m->diameter_bottom_m + (m->diameter_top_m - m->diameter_bottom_m) * f;
+}
+
+static void model_geom(const cyl_landmark_model *m, band_geom *g)
+{
+    double below = 0.0;
+    int k;
     for (k = m->n_bands - 1; k >= 0; k--) {
-        double d_bot = m->diameter_bottom_m, d_top = m->diameter_bottom_m;
-        if (m->shape == CYL_SHAPE_CONE) {
-            double z0 = below, z1 = below + m->band_height_m[k];
-            d_bot = m->diameter_bottom_m + (m->diameter_top_m - m->diameter_bottom_m) * z0 / total;
-            d_top = m->diameter_bottom_m + (m->diameter_top_m - m->diameter_bottom_m) * z1 / total;
-        }
+        const double d_bot = cyl_landmark_diameter_at_m(m, below);
+        const double d_top = cyl_landmark_diameter_at_m(m, below + m->band_height_m[k]);
         g->width_m[k] = d_bot > d_top ? d_bot : d_top;
         below += m->band_height_m[k];
     }

@@ -301,12 +301,12 @@ cyl_status cyl_observe_groups(const cyl_segmentation *seg, const cyl_group *grou
          * be right). The camera's height is then counted from the plane at z_ref. */
         {
             double z = -plane_height_m, zw = 0.0, ww = 0.0;
-            const double d_top = m->shape == CYL_SHAPE_CONE ? m->diameter_top_m : m->diameter_bottom_m;
+            const double d_top = cyl_landmark_diameter_at_m(m, total_h);
             cyl_camera cam_ref = *cam;
             for (k = m->n_bands - 1; k >= 0; k--) {
                 const double z0 = z, z1 = z + m->band_height_m[k];
-                const double d0 = m->diameter_bottom_m + (d_top - m->diameter_bottom_m) * (z0 + plane_height_m) / total_h;
-                const double d1 = m->diameter_bottom_m + (d_top - m->diameter_bottom_m) * (z1 + plane_height_m) / total_h;
+                const double d0 = cyl_landmark_diameter_at_m(m, z0 + plane_height_m);
+                const double d1 = cyl_landmark_diameter_at_m(m, z1 + plane_height_m);
                 const double w = m->band_height_m[k] * 0.5 * (d0 + d1);
                 if (mask & (1u << k)) {
                     zw += w * 0.5 * (z0 + z1);

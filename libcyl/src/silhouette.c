@@ -220,8 +220,8 @@ cyl_status cyl_silhouette_bias_model(const cyl_camera *cam, double x_m, double y
                                      double rel_sigma, double sigma_px, cyl_silhouette_bias *out)
 {
     double hull[NPTS + 1][2], occ[NPTS + 1][2], cut[CLIP_MAX][2], tmp[CLIP_MAX][2];
-    double m[3] = {0.0, 0.0, 0.0}, z_band[CYL_MODEL_MAX_BANDS + 1], total = 0.0, xc, yc;
-    double r_bot, r_top;
+    double m[3] = {0.0, 0.0, 0.0}, z_band[CYL_MODEL_MAX_BANDS + 1], xc, yc;
+    double r_bot;
     mount mt;
     int k, counted = 0;
     cyl_status s;
@@ -235,12 +235,10 @@ cyl_status cyl_silhouette_bias_model(const cyl_camera *cam, double x_m, double y
     if (s != CYL_OK) return s;
     mount_of(cam, &mt);
     /* band k spans z_band[k + 1] .. z_band[k] (top to bottom; z above the centroid plane) */
-    for (k = 0; k < model->n_bands; k++) total += model->band_height_m[k];
     z_band[model->n_bands] = base_z_m;
     for (k = model->n_bands - 1; k >= 0; k--) z_band[k] = z_band[k + 1] + model->band_height_m[k];
     r_bot = polygon_radius(0.5 * model->diameter_bottom_m);
-    r_top = model->shape == CYL_SHAPE_CONE ? polygon_radius(0.5 * model->diameter_top_m) : r_bot;
-#define RADIUS_AT(z) (r_bot + (r_top - r_bot) * ((z) - base_z_m) / total)
+#define RADIUS_AT(z) polygon_radius(0.5 * cyl_landmark_diameter_at_m(model, (z) - base_z_m))
     for (k = 0; k < model->n_bands; k++) {
         const double z1 = z_band[k], z0 = z_band[k + 1];
         double mk[3] = {0.0, 0.0, 0.0}, mc[3] = {0.0, 0.0, 0.0};

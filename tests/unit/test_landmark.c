@@ -601,6 +601,23 @@ static void test_brute_force(void **st)
     assert_true(ids > 100);
 }
 
+/* The shape in one place: the cone above is 0.30 m tall, 0.25 m wide at the base and 0.05 m at the
+ * top, so 0.25 - 0.20 * 2/3 = 0.11667 m at z = 0.20 m; below the base and above the top the end
+ * diameters; a cylinder its base diameter at every height. */
+static void test_diameter_at(void **st)
+{
+    cyl_landmark_model m = cone_model();
+    (void)st;
+    assert_float_equal(cyl_landmark_height_m(&m), 0.30, 1e-12);
+    assert_float_equal(cyl_landmark_diameter_at_m(&m, 0.0), 0.25, 1e-12);
+    assert_float_equal(cyl_landmark_diameter_at_m(&m, 0.20), 0.25 - 0.20 * 2.0 / 3.0, 1e-12);
+    assert_float_equal(cyl_landmark_diameter_at_m(&m, 0.30), 0.05, 1e-12);
+    assert_float_equal(cyl_landmark_diameter_at_m(&m, -1.0), 0.25, 1e-12);
+    assert_float_equal(cyl_landmark_diameter_at_m(&m, 9.0), 0.05, 1e-12);
+    m.shape = CYL_SHAPE_CYLINDER;
+    assert_float_equal(cyl_landmark_diameter_at_m(&m, 0.20), 0.25, 1e-12);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -612,6 +629,7 @@ int main(void)
         cmocka_unit_test(test_single_band),
         cmocka_unit_test(test_checks),
         cmocka_unit_test(test_brute_force),
+        cmocka_unit_test(test_diameter_at),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

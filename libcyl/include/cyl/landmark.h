@@ -117,6 +117,14 @@ cyl_group_params cyl_group_params_default(void);
  * bands, and CYL_ERR_CLASS for a class index >= CYL_MAX_CLASSES. */
 cyl_status cyl_landmark_models_check(const cyl_landmark_model *models, uint32_t n_models);
 
+/* The model's height, m: the sum of its band heights. */
+double cyl_landmark_height_m(const cyl_landmark_model *m);
+
+/* The model's diameter, m, at height z_m above its base (clamped to 0 .. its height): the base
+ * diameter throughout for a cylinder, linear from base to top for a cone. The one place the shape
+ * is interpreted: grouping, observation and silhouette all ask here. */
+double cyl_landmark_diameter_at_m(const cyl_landmark_model *m, double z_m);
+
 /* Workspace bytes cyl_group_blobs() needs for a segmentation of up to max_blobs blobs. */
 size_t cyl_group_work_size(uint32_t max_blobs, const cyl_group_params *p);
 
