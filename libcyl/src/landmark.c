@@ -163,24 +163,6 @@ static int pair_ok(const grp_ctx *c, const cyl_landmark_model *m, const band_geo
     return 1;
 }
 
-/* Cost of a whole assignment (pairs in band order), or -1 if it is not compatible. */
-static double assignment_cost(const grp_ctx *c, const cyl_landmark_model *m, const band_geom *g,
-                              const uint32_t *blob)
-{
-    const cyl_blob *bl = c->seg->blobs;
-    double cost = 0.0;
-    int i, j;
-    for (i = 0; i < m->n_bands; i++) {
-        if (blob[i] == CYL_NONE) continue;
-        if (!fits(c, m, g, i, &bl[blob[i]])) return -1.0;
-        for (j = i + 1; j < m->n_bands; j++) {
-            if (blob[j] == CYL_NONE) continue;
-            if (!pair_ok(c, m, g, i, &bl[blob[i]], j, &bl[blob[j]], &cost)) return -1.0;
-        }
-    }
-    return cost;
-}
-
 static int in_only(const grp_ctx *c, uint32_t b)
 {
     uint32_t i;
@@ -189,10 +171,11 @@ static int in_only(const grp_ctx *c, uint32_t b)
     return 0;
 }
 
-/* Depth-first enumeration of the compatible assignments of model mi, band k onwards. With
- * c->only set, blobs are drawn from it and the search stops at the first assignment that uses
- * all of them. */
-static void enumerate(grp_ctx *c, uint16_t mi, const band_geom *g, int k, uint8_t n)
+/* Depth-first enumeration of the compatible assignments of model mi, band k onwards; `cost` is the
+ * sum of the pair costs of the bands assigned so far (each pair's cost is added when its lower
+ * blob is placed, so a complete assignment arrives with its cost). With c->only set, blobs are
+ * drawn from it and the search stops at the first assignment that uses all of them. */
+static void enumerate(grp_ctx *c, uint16_t mi, const band_geom *g, int k, uint8_t n, double cost)
 {
     const cyl_landmark_model *m = &c->models[mi];
     const cyl_blob *bl = c->seg->blobs;
@@ -214,29 +197,29 @@ static void enumerate(grp_ctx *c, uint16_t mi, const band_geom *g, int k, uint8_
             memcpy(d->blob, c->cur, sizeof d->blob);
             d->model = mi;
             d->n = n;
-            d->cost = assignment_cost(c, m, g, c->cur);
+            d->cost = cost;
         }
         return;
     }
     cls = m->band_cls[k];
     c->cur[k] = CYL_NONE;
-    enumerate(c, mi, g, k + 1, n);   /* the band left empty (always, for a gap) */
+    enumerate(c, mi, g, k + 1, n, cost);   /* the band left empty (always, for a gap) */
     if (cls == CYL_BAND_GAP) return;
     first = c->seg->class_first[cls];
     last = first + c->seg->class_count[cls];
     for (b = first; b < last && b < c->seg->n_blobs; b++) {
-        double dummy = 0.0;
+        double pc = 0.0;
         int i, ok;
         if (c->only && !in_only(c, b)) continue;
         if (!fits(c, m, g, k, &bl[b])) continue;
         ok = 1;
         for (i = 0; i < k && ok; i++) {
             if (c->cur[i] == CYL_NONE) continue;
-            if (c->cur[i] == b || !pair_ok(c, m, g, i, &bl[c->cur[i]], k, &bl[b], &dummy)) ok = 0;
+            if (c->cur[i] == b || !pair_ok(c, m, g, i, &bl[c->cur[i]], k, &bl[b], &pc)) ok = 0;
         }
         if (!ok) continue;
         c->cur[k] = b;
-        enumerate(c, mi, g, k + 1, (uint8_t)(n + 1));
+        enumerate(c, mi, g, k + 1, (uint8_t)(n + 1), cost + pc);
         c->cur[k] = CYL_NONE;
         if (c->found) return;
     }
@@ -369,7 +352,7 @@ static void judge_group(grp_ctx *c, cyl_group *o)
         if (mi == o->model) continue;
         model_geom(&c->models[mi], &g);
         c->found = 0;
-        enumerate(c, (uint16_t)mi, &g, 0, 0);
+        enumerate(c, (uint16_t)mi, &g, 0, 0, 0.0);
         if (c->found) o->flags |= CYL_GROUP_AMBIGUOUS;
     }
     c->only = NULL;
@@ -420,7 +403,7 @@ cyl_status cyl_group_blobs(const cyl_segmentation *seg, const cyl_landmark_model
         int k;
         model_geom(&models[mi], &g);
         for (k = 0; k < CYL_MODEL_MAX_BANDS; k++) c.cur[k] = CYL_NONE;
-        enumerate(&c, (uint16_t)mi, &g, 0, 0);
+        enumerate(&c, (uint16_t)mi, &g, 0, 0, 0.0);
     }
     sort_cands(c.cands, c.n_cands);
     for (i = 0; i < c.n_cands; i++) {
