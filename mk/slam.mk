@@ -45,7 +45,7 @@ mrclam: $(VENV)/.stamp
 # the noise model learned from MRCLAM Dataset 7's residuals against its truth (the shipped
 # slam_demo/cylslam/models/mrclam_noise.json was written by this, from ../shared's Dataset 7)
 mrclam-noise: $(VENV)/.stamp
-	$(CYLSLAM) mrclam-noise --dir $(MRCLAM_DIR) --out $(SLAM_OUT)/mrclam_noise.json
+	$(CYLSLAM) mrclam-noise --dir $(MRCLAM_DIR) --slam-check --out $(SLAM_OUT)/mrclam_noise.json
 
 victoria: $(VENV)/.stamp
 	$(CYLSLAM) victoria --out $(SLAM_OUT)/victoria

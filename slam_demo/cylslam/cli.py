@@ -567,6 +567,13 @@ def cmd_mrclam_noise(args):
     for c in ("x", "y", "theta"):
         o = model.odom[c]
         print(f"| {c} | {o['k_t']:.3g} | {o['k_d']:.3g} | {o['k_a']:.3g} |")
+    for what, corr in (("measurement errors, per robot and landmark", model.corr),
+                       ("odometry step errors, per robot", model.odom_corr)):
+        if corr:
+            print(f"correlation in time of the {what} (rho(dt) = a1 exp(-dt/tau1) + a2 exp(-dt/tau2); "
+                  "each variance is multiplied by the sum of its correlations):")
+            for comp, c in corr.items():
+                print(f"  {comp}: a1 {c['a1']:.3f} tau1 {c['tau1_s']:.3g} s, a2 {c['a2']:.3f} tau2 {c['tau2_s']:.3g} s")
     own = nm.check(model, rep["datasets"])
     print("on the fitting data:", json.dumps(_r(own, 3)))
     summary = {"kernel": model.kernel, "kernel_k": model.kernel_k, **{k: model.meas[k] for k in model.meas},
@@ -578,7 +585,21 @@ def cmd_mrclam_noise(args):
         summary["held_out"] = []
         for train, test, m2, ch in cc:
             print(f"fit on robots {train} ({m2.kernel}), judged on {test}:", json.dumps(_r(ch, 3)))
-            summary["held_out"].append({"train": train, "test": test, **ch})
+            row = {"train": train, "test": test, **ch}
+            if args.slam_check:
+                from .backend import Params, Slam
+                from . import metrics
+                row["slam"] = {}
+                for rb in test:
+                    ds = read_robot(rb, m2)
+                    res = Slam(Params(assoc="known", robust=m2.kernel if m2.kernel != "gaussian" else "none",
+                                      huber_k=m2.kernel_k or 1.0)).run(ds)
+                    mm = metrics.evaluate(ds, res)
+                    row["slam"][str(rb)] = {k: mm.get(k) for k in ("ate_m", "anees_landmarks", "anees_poses",
+                                                                  "landmark_rmse_m")}
+                    print(f"  SLAM (known association) on held-out robot {rb}: aligned RMSE {mm['ate_m']:.3f} m, "
+                          f"landmark ANEES {mm['anees_landmarks']:.2f}, pose ANEES {mm['anees_poses']:.2f}")
+            summary["held_out"].append(row)
     if args.out:
         try:
             model.save(args.out)
@@ -690,6 +711,9 @@ def build_parser():
     sp.add_argument("--out", default=None, help="write the model (JSON) here")
     sp.add_argument("--robots", default="1,2,3,4,5", help="robots to fit on (default %(default)s)")
     sp.add_argument("--no-cross-check", action="store_true", help="skip the held-out robot check")
+    sp.add_argument("--slam-check", action="store_true",
+                    help="in the held-out check, also map each held-out robot with the model fitted without it "
+                         "(known association) and print its RMSE and ANEES")
     sp.set_defaults(func=cmd_mrclam_noise)
 
     sp = sub.add_parser("victoria", help="SLAM on gtsam's Victoria Park file (no truth)",

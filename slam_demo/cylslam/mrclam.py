@@ -187,21 +187,32 @@ def read_mrclam(directory, robot, duration=None, keyframe_dt=0.5, noise="range",
     n_no_truth = int(np.isnan(truth[:, 0]).sum())
     if n_no_truth:
         notes.append(f"{n_no_truth} of {len(times)} steps have no ground truth (Vicon gaps)")
+    oinfl = (model.odom_inflation(times) if model is not None and model.odom_corr is not None
+             else np.ones((len(times), 3)))
     steps = []
     for k, t in enumerate(times):
         s = Step(t=float(t), seq=k, truth=None if np.isnan(truth[k, 0]) else truth[k])
         if k > 0:
             inc = between(dr[k - 1], dr[k])
             if model is not None:
-                s.odom_cov = odom_scale ** 2 * model.odom_cov(inc, t - times[k - 1])
+                s.odom_cov = odom_scale ** 2 * model.odom_cov(inc, t - times[k - 1]) * oinfl[k]
             else:
                 sx, sy, st = (odom_scale * v for v in odom_sigmas(inc, t - times[k - 1]))
                 s.odom_cov = np.diag([sx * sx, sy * sy, st * st])
             s.odom = inc
         steps.append(s)
+    # a learned model's errors are correlated in time along one landmark's measurements: each
+    # measurement's variance is multiplied by the sum of its correlations (noise_model.py)
+    infl = np.ones((len(keep), 2))
+    if model is not None and model.corr is not None:
+        by_lm = {}
+        for n_line, (t, s, r, br) in enumerate(keep):
+            by_lm.setdefault(s, []).append(n_line)
+        for idx in by_lm.values():
+            infl[idx] = model.inflation([keep[i][0] for i in idx])
     for n_line, (t, s, r, br) in enumerate(keep):
         steps[step_of[t]].obs.append(Obs(cls="barcode", range_m=float(r), bearing_rad=float(br),
-                                     cov=model.meas_cov(r) if model is not None else meas_cov(r, noise),
+                                     cov=model.meas_cov(r, infl[n_line]) if model is not None else meas_cov(r, noise),
                                      lm_id=int(s),
                                      where=f"Robot{robot}_Measurement.dat t={t:.3f}"))
     tl = {int(s): (float(x), float(y), "barcode") for s, x, y in lmgt}

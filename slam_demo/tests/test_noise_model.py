@@ -88,7 +88,7 @@ def test_model_round_trip_and_strict_reading(tmp_path):
     p = str(tmp_path / "m.json")
     _model().save(p)
     m = nm.NoiseModel.load(p)
-    assert m.kernel == "cauchy" and m.kernel_k == 2.3 and m.meas == TRUE
+    assert m.kernel == "cauchy" and m.kernel_k == 2.3 and m.meas == TRUE and m.corr is None
     assert np.allclose(np.sqrt(np.diag(m.meas_cov(2.0))),
                        [math.hypot(0.04, 0.05), math.hypot(0.006, 0.0075)])
     j = json.load(open(p))
@@ -130,10 +130,18 @@ def test_model_file_never_replaces_a_device_or_a_link(tmp_path):
 def test_the_shipped_model_reads_and_applies():
     m = nm.NoiseModel.load(nm.DEFAULT_PATH)
     ds = read_mrclam(MR, 2, model=m)
-    o = next(o for s in ds.steps for o in s.obs)
-    assert np.allclose(o.cov, m.meas_cov(o.range_m))
+    # one landmark's measurements: the model's covariance times the stream's inflation factors
+    lid = ds.steps[next(i for i, s in enumerate(ds.steps) if s.obs)].obs[0].lm_id
+    stream = [o for s in ds.steps for o in s.obs if o.lm_id == lid]
+    times = [float(o.where.split("t=")[1]) for o in stream]
+    f = m.inflation(times)
+    assert len(stream) > 10 and f.min() >= 1.0 and f.max() > 2.0
+    for o, fi in zip(stream, f):
+        assert np.allclose(o.cov, m.meas_cov(o.range_m, fi), rtol=1e-9)
+    times = np.array([s.t for s in ds.steps])
+    fo = m.odom_inflation(times)
     s = ds.steps[5]
-    assert np.allclose(s.odom_cov, m.odom_cov(s.odom, s.t - ds.steps[4].t))
+    assert np.allclose(s.odom_cov, m.odom_cov(s.odom, s.t - ds.steps[4].t) * fo[5])
 
 
 def _cli(*args):
@@ -190,3 +198,38 @@ def test_command_delay_and_scales_are_recovered():
     assert d == pytest.approx(0.2, abs=0.01)
     sv, sw = nm.command_scales(read(nm._odometry_only(delay=d)))
     assert sv == pytest.approx(0.9, abs=0.01) and sw == pytest.approx(0.8, abs=0.01)
+
+
+def test_inflation_is_the_sum_of_correlations():
+    corr = {"a1": 0.6, "tau1_s": 2.0, "a2": 0.2, "tau2_s": 20.0}
+    m = nm.NoiseModel(dict(TRUE), {c: {"k_t": 0.0, "k_d": 0.0, "k_a": 0.0} for c in ("x", "y", "theta")},
+                      corr={"range": corr, "bearing": corr}, odom_corr={"x": corr, "y": corr, "theta": corr})
+    t = [0.0, 1.0, 5.0]
+    rho = lambda d: 0.6 * math.exp(-d / 2.0) + 0.2 * math.exp(-d / 20.0)  # noqa: E731
+    want = [1 + rho(1) + rho(5), 1 + rho(1) + rho(4), 1 + rho(5) + rho(4)]
+    f = m.inflation(t)
+    assert np.allclose(f[:, 0], want) and np.allclose(f[:, 1], want)
+    assert np.allclose(m.odom_inflation(t)[:, 2], want)
+    # a lone measurement, or no correlation model: factor 1
+    assert np.allclose(m.inflation([3.0]), 1.0)
+    m.corr = None
+    assert np.allclose(m.inflation(t), 1.0)
+
+
+def test_correlation_of_an_exponentially_correlated_stream_is_recovered():
+    # AR(1) samples every 0.5 s with correlation exp(-dt / 4 s), 40 streams of 400
+    rng = np.random.default_rng(9)
+    tau, dt = 4.0, 0.5
+    phi = math.exp(-dt / tau)
+    streams = []
+    for _ in range(40):
+        z = np.empty(400)
+        z[0] = rng.normal()
+        for i in range(1, 400):
+            z[i] = phi * z[i - 1] + math.sqrt(1 - phi * phi) * rng.normal()
+        t = np.arange(400) * dt
+        streams.append(np.stack([t, np.full(400, 2.0), z, z], 1))
+    centres, counts, rr, rb = nm.empirical_correlation(streams, lambda r: (np.ones(len(r)), np.ones(len(r))), clip=10)
+    c = nm.fit_correlation(centres, counts, rr, terms=1)
+    assert c["a1"] == pytest.approx(1.0, abs=0.1)
+    assert c["tau1_s"] == pytest.approx(tau, rel=0.2)
