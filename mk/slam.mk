@@ -38,9 +38,12 @@ slam-synth: $(VENV)/.stamp
 
 mrclam: $(VENV)/.stamp
 	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc known --multi --out $(SLAM_OUT)/mrclam-known \
-	  --check-rmse 0.15 --check-time 30
-	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc unknown --odom-scale 4 --out $(SLAM_OUT)/mrclam-unknown
-	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc known --noise learned --multi --out $(SLAM_OUT)/mrclam-known-learned
+	  --summary-out $(SLAM_OUT)/mrclam-known.json --check-rmse 0.15 --check-time 30
+	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc unknown --odom-scale 4 --out $(SLAM_OUT)/mrclam-unknown \
+	  --summary-out $(SLAM_OUT)/mrclam-unknown.json
+	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc known --noise learned --multi \
+	  --out $(SLAM_OUT)/mrclam-known-learned --summary-out $(SLAM_OUT)/mrclam-known-learned.json
+	@$(VENV_PY) scripts/mrclam_summary.py $(SLAM_OUT)
 
 # the noise model learned from MRCLAM Dataset 7's residuals against its truth (the shipped
 # slam_demo/cylslam/models/mrclam_noise.json was written by this, from ../shared's Dataset 7)

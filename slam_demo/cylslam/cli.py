@@ -279,7 +279,7 @@ def print_summary(s, out=sys.stdout):
 LAST_KEYS = ("ate_m", "ate_unaligned_m", "landmark_rmse_m", "anees_landmarks", "anees_poses",
              "anees_landmarks_joint", "anees_poses_joint",
              "association_errors", "ate_fixed_cov_m", "landmark_rmse_fixed_cov_m",
-             "anees_landmarks_fixed_cov", "fixed_cov_failed", "ate_dead_reckoning_m")
+             "anees_landmarks_fixed_cov", "fixed_cov_failed", "ate_dead_reckoning_m", "landmarks_estimated")
 
 
 def last_line(s, extra=None):
@@ -474,6 +474,15 @@ def cmd_mrclam(args):
     agg["time_s"] = max(s["stats"]["t_total_s"] for _, s in rows)
     agg["worst_robot"] = max(rows, key=lambda r: r[1]["ate_m"])[0]
     agg["robots"] = per
+    agg["aligned_rmse_max_m"] = max(s["ate_m"] for _, s in rows)
+    lm_anees = [s.get("anees_landmarks") for _, s in rows if s.get("anees_landmarks") is not None]
+    agg["anees_landmarks_max"] = max(lm_anees) if lm_anees else None
+    n_lm = [s.get("landmarks_estimated") for _, s in rows if s.get("landmarks_estimated") is not None]
+    agg["landmarks_min"], agg["landmarks_max"] = (min(n_lm), max(n_lm)) if n_lm else (None, None)
+    agg["parameters"] = {"assoc": args.assoc, "noise": args.noise,
+                         "noise_model": args.noise_model if model else None, "robust": args.robust,
+                         "robust_k": args.huber_k if args.robust != "none" else None,
+                         "odom_scale": args.odom_scale, "gate": args.gate, "new_gate": args.new_gate}
     if args.multi:
         agg.update(multi_robot(args, model, robots))
         if args.check_rmse is not None:
@@ -483,7 +492,15 @@ def cmd_mrclam(args):
                 rc = EXIT_CHECK
             else:
                 print(f"checks passed: one map: every robot's RMSE in the joint frame <= {args.check_rmse} m")
-    print(json.dumps(_r(agg, 4)))
+    line = json.dumps(_r(agg, 4))
+    if args.summary_out:
+        from .noise_model import NoiseModelError, write_text_safely
+        try:
+            write_text_safely(args.summary_out, line + "\n")
+        except NoiseModelError as e:
+            print(f"cylslam: error: {e}", file=sys.stderr)
+            return EXIT_OUTPUT
+    print(line)
     return rc
 
 
@@ -695,6 +712,8 @@ def build_parser():
     sp.add_argument("--check-rmse", type=float, default=None,
                     help="exit 1 unless every robot's aligned RMSE is <= this (with --multi: in the joint "
                          "frame too)")
+    sp.add_argument("--summary-out", default=None, metavar="FILE",
+                    help="also write the last line (JSON) to FILE")
     sp.add_argument("--check-time", type=float, default=None,
                     help="with --check-rmse: exit 1 if a robot's run takes longer (s)")
     add_common(sp, assoc_default="known", robust_default=None, fixed_default="mean")

@@ -66,3 +66,25 @@ def test_a_robot_sharing_no_landmark_is_left_out_with_a_note():
     res = run_multi([a, b], ["A", "B"], Params(assoc="known", robust="huber"))
     assert res.robots == ["A"]
     assert any("B: shares 0 landmark(s)" in n for n in res.notes)
+
+
+def test_mrclam_summary_combines_the_runs(tmp_path):
+    import json
+    import subprocess
+    import sys
+    script = os.path.join(os.path.dirname(__file__), "..", "..", "scripts", "mrclam_summary.py")
+    base = {"aligned_rmse_max_m": 0.1, "anees_landmarks_max": 2.0, "landmarks_min": 14, "landmarks_max": 16,
+            "parameters": {"assoc": "known"}}
+    for name, extra in (("known", {"multi_aligned_rmse_max_m": 0.12, "multi_landmark_rmse_m": 0.05}),
+                        ("unknown", {"aligned_rmse_max_m": 0.9, "landmarks_min": 20}),
+                        ("known-learned", {"multi_anees_landmarks": 0.9})):
+        (tmp_path / f"mrclam-{name}.json").write_text("progress line\n" + json.dumps({**base, **extra}) + "\n")
+    r = subprocess.run([sys.executable, script, str(tmp_path)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    s = json.loads(r.stdout)
+    assert s["unknown_aligned_rmse_max_m"] == 0.9 and s["unknown_landmarks_min"] == 20
+    assert s["multi_landmark_rmse_m"] == 0.05 and s["learned_multi_landmark_anees"] == 0.9
+    assert s["known_landmark_anees_max"] == 2.0
+    (tmp_path / "mrclam-unknown.json").unlink()
+    r = subprocess.run([sys.executable, script, str(tmp_path)], capture_output=True, text=True)
+    assert r.returncode == 3 and "mrclam-unknown.json" in r.stderr
