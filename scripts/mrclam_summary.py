@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: BSD-3-Clause
 """The last line of `make mrclam`: one JSON object from the summaries of its runs (each written by
-`cylslam mrclam --summary-out`): known association with the fixed noise model and its one-map run,
-unknown association, known association with the learned noise model and its one-map run; with the
-parameters of each run and where they came from.
+`cylslam mrclam --summary-out`): with the learned noise model, known association with its one-map
+run and unknown association (the same parameters in every mode); with the reader's fixed model,
+known association with its one-map run (fixed_*). Each run's parameters are listed with their
+source.
 
-usage: mrclam_summary.py OUT_DIR   (reads OUT_DIR/mrclam-{known,unknown,known-learned}.json)
+usage: mrclam_summary.py OUT_DIR   (reads OUT_DIR/mrclam-{known,unknown,fixed-known}.json)
 """
 import json
 import os
@@ -18,7 +19,7 @@ def main(argv):
         return 0 if len(argv) == 2 else 2
     out = argv[1]
     runs = {}
-    for name in ("known", "unknown", "known-learned"):
+    for name in ("known", "unknown", "fixed-known"):
         path = os.path.join(out, f"mrclam-{name}.json")
         try:
             with open(path) as fh:
@@ -26,7 +27,8 @@ def main(argv):
         except (OSError, ValueError, IndexError) as e:
             print(f"mrclam_summary: {path}: {e}", file=sys.stderr)
             return 3
-    k, u, kl = runs["known"], runs["unknown"], runs["known-learned"]
+    k, u, f = runs["known"], runs["unknown"], runs["fixed-known"]
+    learned = "learned from the data set's truth by `cylslam mrclam-noise` (cylslam/noise_model.py)"
     summary = {
         "known_aligned_rmse_max_m": k["aligned_rmse_max_m"],
         "known_landmark_anees_max": k["anees_landmarks_max"],
@@ -35,17 +37,15 @@ def main(argv):
         "unknown_landmarks_max": u["landmarks_max"],
         "multi_aligned_rmse_max_m": k.get("multi_aligned_rmse_max_m"),
         "multi_landmark_rmse_m": k.get("multi_landmark_rmse_m"),
-        "learned_known_aligned_rmse_max_m": kl["aligned_rmse_max_m"],
-        "learned_known_landmark_anees_max": kl["anees_landmarks_max"],
-        "learned_multi_aligned_rmse_max_m": kl.get("multi_aligned_rmse_max_m"),
-        "learned_multi_landmark_rmse_m": kl.get("multi_landmark_rmse_m"),
-        "learned_multi_landmark_anees": kl.get("multi_anees_landmarks"),
+        "multi_landmark_anees": k.get("multi_anees_landmarks"),
+        "fixed_known_aligned_rmse_max_m": f["aligned_rmse_max_m"],
+        "fixed_known_landmark_anees_max": f["anees_landmarks_max"],
+        "fixed_multi_aligned_rmse_max_m": f.get("multi_aligned_rmse_max_m"),
+        "fixed_multi_landmark_rmse_m": f.get("multi_landmark_rmse_m"),
         "parameters": {
-            "known": {**k["parameters"], "source": "the reader's fixed models (cylslam/mrclam.py), Huber 1.345"},
-            "unknown": {**u["parameters"], "source": "odometry sigmas x4 chosen on Dataset 7 itself (slam_demo/README.md)"},
-            "known-learned": {**kl["parameters"],
-                              "source": "learned from Dataset 7's truth by `cylslam mrclam-noise` "
-                                        "(cylslam/noise_model.py)"},
+            "known": {**k["parameters"], "source": learned},
+            "unknown": {**u["parameters"], "source": learned + "; gates are chi-square probabilities"},
+            "fixed-known": {**f["parameters"], "source": "the reader's fixed models (cylslam/mrclam.py), Huber 1.345"},
         },
     }
     print(json.dumps(summary))

@@ -77,13 +77,13 @@ def test_mrclam_summary_combines_the_runs(tmp_path):
             "parameters": {"assoc": "known"}}
     for name, extra in (("known", {"multi_aligned_rmse_max_m": 0.12, "multi_landmark_rmse_m": 0.05}),
                         ("unknown", {"aligned_rmse_max_m": 0.9, "landmarks_min": 20}),
-                        ("known-learned", {"multi_anees_landmarks": 0.9})):
+                        ("fixed-known", {"multi_landmark_rmse_m": 0.07})):
         (tmp_path / f"mrclam-{name}.json").write_text("progress line\n" + json.dumps({**base, **extra}) + "\n")
     r = subprocess.run([sys.executable, script, str(tmp_path)], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     s = json.loads(r.stdout)
     assert s["unknown_aligned_rmse_max_m"] == 0.9 and s["unknown_landmarks_min"] == 20
-    assert s["multi_landmark_rmse_m"] == 0.05 and s["learned_multi_landmark_anees"] == 0.9
+    assert s["multi_landmark_rmse_m"] == 0.05 and s["fixed_multi_landmark_rmse_m"] == 0.07
     assert s["known_landmark_anees_max"] == 2.0
     (tmp_path / "mrclam-unknown.json").unlink()
     r = subprocess.run([sys.executable, script, str(tmp_path)], capture_output=True, text=True)
