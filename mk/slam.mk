@@ -3,7 +3,10 @@
 #   make slam-venv     the project-local venv .venv/ (gtsam==4.3.0, numpy, matplotlib, pytest)
 #   make slam-test     the slam_demo pytest suite (also part of `make test`)
 #   make slam-synth    synthetic log -> SLAM -> plots, metrics, acceptance check (out/slam/synth)
-#   make mrclam        MRCLAM Dataset 7, all 5 robots, known + unknown association (out/slam/mrclam*)
+#   make mrclam        MRCLAM Dataset 7, all 5 robots: the learned noise model with known and unknown
+#                      association and one map of all robots; the fixed model's known association,
+#                      checked (out/slam/mrclam*); last line JSON
+#   make mrclam-noise  learn the noise model from Dataset 7's truth, with the held-out robot check
 #   make victoria      gtsam's Victoria Park file (out/slam/victoria)
 #   make slam-run LOG=FILE.jsonl [SLAM_ARGS=...]   SLAM on any observation log (out/slam/<name>)
 # MRCLAM_DIR points at the UTIAS MRCLAM data set (not used by `make test`).
@@ -39,6 +42,7 @@ slam-synth: $(VENV)/.stamp
 # the learned noise model in every mode (known, unknown, one map), and the fixed model's known
 # association with its check (<= 0.15 m per robot, as before the model was learned)
 mrclam: $(VENV)/.stamp
+	@mkdir -p $(SLAM_OUT)
 	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc known --multi --out $(SLAM_OUT)/mrclam-fixed-known \
 	  --summary-out $(SLAM_OUT)/mrclam-fixed-known.json --check-rmse 0.15 --check-time 30
 	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc known --noise learned --multi \
@@ -50,6 +54,7 @@ mrclam: $(VENV)/.stamp
 # the noise model learned from MRCLAM Dataset 7's residuals against its truth (the shipped
 # slam_demo/cylslam/models/mrclam_noise.json was written by this, from ../shared's Dataset 7)
 mrclam-noise: $(VENV)/.stamp
+	@mkdir -p $(SLAM_OUT)
 	$(CYLSLAM) mrclam-noise --dir $(MRCLAM_DIR) --slam-check --out $(SLAM_OUT)/mrclam_noise.json
 
 victoria: $(VENV)/.stamp

@@ -27,6 +27,17 @@ def main(argv):
         except (OSError, ValueError, IndexError) as e:
             print(f"mrclam_summary: {path}: {e}", file=sys.stderr)
             return 3
+    try:
+        summary = combine(runs)
+    except (KeyError, TypeError) as e:
+        print(f"mrclam_summary: {out}: a run's summary lacks {e} (written by another cylslam version?)",
+              file=sys.stderr)
+        return 3
+    print(json.dumps(summary))
+    return 0
+
+
+def combine(runs):
     k, u, f = runs["known"], runs["unknown"], runs["fixed-known"]
     learned = "learned from the data set's truth by `cylslam mrclam-noise` (cylslam/noise_model.py)"
     summary = {
@@ -35,21 +46,20 @@ def main(argv):
         "unknown_aligned_rmse_max_m": u["aligned_rmse_max_m"],
         "unknown_landmarks_min": u["landmarks_min"],
         "unknown_landmarks_max": u["landmarks_max"],
-        "multi_aligned_rmse_max_m": k.get("multi_aligned_rmse_max_m"),
-        "multi_landmark_rmse_m": k.get("multi_landmark_rmse_m"),
-        "multi_landmark_anees": k.get("multi_anees_landmarks"),
+        "multi_aligned_rmse_max_m": k["multi_aligned_rmse_max_m"],
+        "multi_landmark_rmse_m": k["multi_landmark_rmse_m"],
+        "multi_landmark_anees": k["multi_anees_landmarks"],
         "fixed_known_aligned_rmse_max_m": f["aligned_rmse_max_m"],
         "fixed_known_landmark_anees_max": f["anees_landmarks_max"],
-        "fixed_multi_aligned_rmse_max_m": f.get("multi_aligned_rmse_max_m"),
-        "fixed_multi_landmark_rmse_m": f.get("multi_landmark_rmse_m"),
+        "fixed_multi_aligned_rmse_max_m": f["multi_aligned_rmse_max_m"],
+        "fixed_multi_landmark_rmse_m": f["multi_landmark_rmse_m"],
         "parameters": {
             "known": {**k["parameters"], "source": learned},
             "unknown": {**u["parameters"], "source": learned + "; gates are chi-square probabilities"},
             "fixed-known": {**f["parameters"], "source": "the reader's fixed models (cylslam/mrclam.py), Huber 1.345"},
         },
     }
-    print(json.dumps(summary))
-    return 0
+    return summary
 
 
 if __name__ == "__main__":

@@ -175,6 +175,20 @@ class Result:
     info: Optional["Information"] = None  # the information matrix at the estimate (joint NEES)
 
 
+def drop_reason(o, p):
+    """Why an observation is not used ("dropped_flags", "dropped_no_range", "dropped_confidence",
+    "dropped_far"), or None: the one rule for every run."""
+    if o.flags & p.reject_flags:
+        return "dropped_flags"
+    if (o.flags & FLAG_NO_RANGE) or o.range_m <= 0:
+        return "dropped_no_range"
+    if o.confidence < p.conf_min:
+        return "dropped_confidence"
+    if p.max_range_rel_sigma is not None and math.sqrt(max(o.cov[0, 0], 0.0)) > p.max_range_rel_sigma * o.range_m:
+        return "dropped_far"
+    return None
+
+
 class Slam:
     def __init__(self, params: Params, progress=None, on_step=None):
         """on_step(i, seq, t, pose, used, isam, lms_init): called after each step as the run
@@ -267,15 +281,9 @@ class Slam:
             usable = []
             for o in s.obs:
                 st["obs_total"] += 1
-                if o.flags & p.reject_flags:
-                    st["dropped_flags"] += 1
-                elif (o.flags & FLAG_NO_RANGE) or o.range_m <= 0:
-                    st["dropped_no_range"] += 1
-                elif o.confidence < p.conf_min:
-                    st["dropped_confidence"] += 1
-                elif (p.max_range_rel_sigma is not None and
-                      math.sqrt(max(o.cov[0, 0], 0.0)) > p.max_range_rel_sigma * o.range_m):
-                    st["dropped_far"] += 1
+                why = drop_reason(o, p)
+                if why:
+                    st[why] += 1
                 else:
                     usable.append(o)
             need = bool(usable) and (mode == "unknown" or

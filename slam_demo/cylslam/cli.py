@@ -20,7 +20,7 @@ import numpy as np
 
 EXIT_OK, EXIT_CHECK, EXIT_USAGE, EXIT_INPUT, EXIT_OUTPUT = 0, 1, 2, 3, 4
 FIXED_GRID = (0.25, 0.5, 1.0, 2.0, 4.0)
-DEFAULT_NOISE_MODEL = os.path.join(os.path.dirname(os.path.abspath(__file__)), "models", "mrclam_noise.json")
+DEFAULT_NOISE_MODEL = None   # --noise-model: the model shipped with cylslam (noise_model.DEFAULT_PATH)
 
 
 class Progress:
@@ -418,7 +418,15 @@ def cmd_mrclam(args):
     robots = [1, 2, 3, 4, 5] if args.robot == "all" else [int(args.robot)]
     rows = []
     model = None
+    if args.noise != "learned" and args.noise_model is not None:
+        print("cylslam: error: --noise-model needs --noise learned", file=sys.stderr)
+        return EXIT_USAGE
+    if args.summary_out and not os.path.isdir(os.path.dirname(os.path.abspath(args.summary_out))):
+        print(f"cylslam: error: --summary-out {args.summary_out}: no such directory", file=sys.stderr)
+        return EXIT_OUTPUT
     if args.noise == "learned":
+        from .noise_model import DEFAULT_PATH
+        args.noise_model = args.noise_model or DEFAULT_PATH
         try:
             model = NoiseModel.load(args.noise_model)
         except NoiseModelError as e:
@@ -494,10 +502,11 @@ def cmd_mrclam(args):
                 print(f"checks passed: one map: every robot's RMSE in the joint frame <= {args.check_rmse} m")
     line = json.dumps(_r(agg, 4))
     if args.summary_out:
-        from .noise_model import NoiseModelError, write_text_safely
+        from .noise_model import write_text_safely
         try:
             write_text_safely(args.summary_out, line + "\n")
         except NoiseModelError as e:
+            print(line)
             print(f"cylslam: error: {e}", file=sys.stderr)
             return EXIT_OUTPUT
     print(line)
@@ -560,6 +569,9 @@ def cmd_mrclam_noise(args):
     except ValueError:
         print(f"cylslam: error: --robots: expected numbers separated by commas, got {args.robots!r}", file=sys.stderr)
         return EXIT_USAGE
+    if args.slam_check and args.no_cross_check:
+        print("cylslam: error: --slam-check is part of the held-out check (drop --no-cross-check)", file=sys.stderr)
+        return EXIT_USAGE
     def read_robot(rb, mdl):
         return read_mrclam(args.dir, rb, model=mdl)
 
@@ -597,8 +609,24 @@ def cmd_mrclam_noise(args):
                "speed_scale": model.cmd_scale[0], "turn_scale": model.cmd_scale[1],
                "command_delay_s": model.cmd_delay_s,
                "fit_check": own}
-    if not args.no_cross_check:
-        cc = nm.cross_check(read_robot, [((1, 3, 5), (2, 4)), ((2, 4), (1, 3, 5))])
+    if args.out:   # before the held-out check, which may fail on its own
+        try:
+            model.save(args.out)
+        except nm.NoiseModelError as e:
+            print(f"cylslam: error: {e}", file=sys.stderr)
+            return EXIT_OUTPUT
+        print(f"wrote {args.out}")
+    # the held-out check: the robots in two halves (1,3,5 / 2,4 for all five), each fitted on one
+    # half and judged on the other
+    halves = (tuple(robots[0::2]), tuple(robots[1::2]))
+    if not args.no_cross_check and not halves[1]:
+        print("note: one robot: no held-out check")
+    elif not args.no_cross_check:
+        try:
+            cc = nm.cross_check(read_robot, [halves, halves[::-1]])
+        except (MrclamError, nm.NoiseModelError) as e:
+            print(f"cylslam: error: held-out check: {e}", file=sys.stderr)
+            return EXIT_INPUT
         summary["held_out"] = []
         for train, test, m2, ch in cc:
             print(f"fit on robots {train} ({m2.kernel}), judged on {test}:", json.dumps(_r(ch, 3)))
@@ -617,13 +645,6 @@ def cmd_mrclam_noise(args):
                     print(f"  SLAM (known association) on held-out robot {rb}: aligned RMSE {mm['ate_m']:.3f} m, "
                           f"landmark ANEES {mm['anees_landmarks']:.2f}, pose ANEES {mm['anees_poses']:.2f}")
             summary["held_out"].append(row)
-    if args.out:
-        try:
-            model.save(args.out)
-        except nm.NoiseModelError as e:
-            print(f"cylslam: error: {e}", file=sys.stderr)
-            return EXIT_OUTPUT
-        print(f"wrote {args.out}")
     print(json.dumps(_r(summary, 4)))
     return EXIT_OK
 
@@ -702,8 +723,8 @@ def build_parser():
                          "measurement and odometry sigmas and the measurement kernel from --noise-model "
                          "(default %(default)s)")
     sp.add_argument("--noise-model", default=DEFAULT_NOISE_MODEL,
-                    help="a model written by `mrclam-noise` (default: the one fitted on Dataset 7, "
-                         "%(default)s)")
+                    help="a model written by `mrclam-noise` (with --noise learned; default: the one fitted "
+                         "on Dataset 7 and shipped with cylslam, cylslam/models/mrclam_noise.json)")
     sp.add_argument("--odom-scale", type=float, default=1.0,
                     help="multiply the odometry sigmas by this (default %(default)s)")
     sp.add_argument("--multi", action="store_true",

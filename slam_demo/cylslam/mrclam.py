@@ -17,6 +17,10 @@ RobotN_Measurement.dat (t, barcode, range, bearing), RobotN_Groundtruth.dat (t, 
 - Ground truth (Vicon) is interpolated linearly (angles unwrapped) at each step; steps farther
   than `max_gap` (0.25 s) from a Vicon sample on either side of a gap get no truth.
 
+With a learned noise model (`model`, noise_model.py) the commands are first shifted by its command
+delay and scaled by its speed and turn scales; its sigmas then replace the models below, each
+measurement's and step's variance multiplied by its stream's correlation sum.
+
 Noise models (documented in README):
 - odometry increment of distance d and rotation a (both of the commanded motion) over dt s:
   sigma_x = 0.05 d + 0.002 sqrt(dt), sigma_y = 0.02 d + 0.002 sqrt(dt),

@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 import gtsam
 import numpy as np
 
-from .backend import Information, L, Slam, X
-from .data import FLAG_NO_RANGE, between
+from .backend import Information, L, Slam, X, drop_reason
+from .data import between
 
 from . import metrics
 
@@ -104,8 +104,9 @@ def run_multi(datasets, labels, params, progress=None) -> MultiResult:
                 graph.add(gtsam.BetweenFactorPose2(X(base + i - 1), X(base + i), gtsam.Pose2(*s.odom),
                                                    slam._odom_noise(s.odom_cov)))
             for o in s.obs:
-                if (o.flags & params.reject_flags) or (o.flags & FLAG_NO_RANGE) or o.range_m <= 0 \
-                        or o.confidence < params.conf_min or o.lm_id is None:
+                # the single-robot runs' rule; a landmark only those runs' dropped observations saw
+                # has no estimate, and its observations stay out too
+                if drop_reason(o, params) or o.lm_id is None or o.lm_id not in ref:
                     continue
                 graph.add(gtsam.BearingRangeFactor2D(X(base + i), L(o.lm_id), gtsam.Rot2(o.bearing_rad),
                                                      o.range_m, slam._obs_noise(o.cov)))

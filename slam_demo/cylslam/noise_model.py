@@ -164,9 +164,11 @@ class NoiseModel:
 
     @staticmethod
     def _inflation(corr, comps, times):
-        t = np.asarray(times, float)
-        if corr is None or len(t) == 0:
-            return np.ones((len(t), len(comps)))
+        t0 = np.asarray(times, float)
+        if corr is None or len(t0) == 0:
+            return np.ones((len(t0), len(comps)))
+        order = np.argsort(t0, kind="stable")          # any order in, the same order out
+        t = t0[order]
         out = np.empty((len(t), len(comps)))
         for c, comp in enumerate(comps):
             for i in range(len(t)):
@@ -175,7 +177,9 @@ class NoiseModel:
                 r = NoiseModel._rho(corr[comp], t[lo:hi] - t[i])
                 r[i - lo] = 1.0
                 out[i, c] = float(np.sum(r[(r >= 1e-3)]))
-        return out
+        back = np.empty_like(out)
+        back[order] = out
+        return back
 
     def odom_inflation(self, times):
         """Variance factors (x, y, theta) for a robot's odometry steps at `times` (s), as
@@ -211,9 +215,19 @@ class NoiseModel:
 
     @staticmethod
     def load(path):
+        """Read a model file strictly: unknown, missing or duplicated keys, values of the wrong
+        type, non-finite or out of range are errors naming the file and the field."""
+        def no_duplicates(pairs):
+            seen = {}
+            for k, v in pairs:
+                if k in seen:
+                    raise NoiseModelError(f"{path}: key {k!r} appears twice in one object")
+                seen[k] = v
+            return seen
+
         try:
             with open(path) as fh:
-                j = json.load(fh)
+                j = json.load(fh, object_pairs_hook=no_duplicates)
         except (OSError, ValueError) as e:
             raise NoiseModelError(f"{path}: {e}")
 
@@ -227,58 +241,62 @@ class NoiseModel:
             if miss:
                 raise NoiseModelError(f"{path}: {where}: missing key(s) {', '.join(sorted(miss))}")
 
+        def num(v, where, lo, hi, lo_open=False):
+            """A finite number (not a boolean) in [lo, hi] (lo excluded when lo_open)."""
+            ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v <= hi and (
+                v > lo if lo_open else v >= lo)
+            if not ok:
+                raise NoiseModelError(f"{path}: {where}: expected a number {'>' if lo_open else '>='} {lo:g} "
+                                      f"and <= {hi:g}, got {v!r}")
+            return float(v)
+
         keys(j, ["format", "version", "measurement", "odometry", "provenance"], "top level")
-        if j["format"] != FORMAT or j["version"] != VERSION:
+        if j["format"] != FORMAT or j["version"] != VERSION or isinstance(j["version"], bool):
             raise NoiseModelError(f"{path}: not a {FORMAT} version {VERSION} file")
+        if not isinstance(j["provenance"], dict):
+            raise NoiseModelError(f"{path}: provenance: expected an object")
         m = j["measurement"]
         keys(m, ["a_r_m", "b_r", "a_b_rad", "b_b_rad_m", "kernel", "kernel_k", "correlation"], "measurement")
+
         def correlation(corr, comps, where):
             if corr is None:
                 return None
             keys(corr, comps, where)
+            out = {}
             for comp in comps:
                 keys(corr[comp], ["a1", "tau1_s", "a2", "tau2_s"], f"{where}.{comp}")
-                c = corr[comp]
-                if not all(isinstance(c[k], (int, float)) for k in c) or not (
-                        0 <= c["a1"] and 0 <= c["a2"] and c["a1"] + c["a2"] <= 1 + 1e-9 and c["tau1_s"] > 0 and c["tau2_s"] > 0):
-                    raise NoiseModelError(f"{path}: {where}.{comp}: expected a1, a2 >= 0 with "
-                                          "a1 + a2 <= 1 and tau1_s, tau2_s > 0")
-            return corr
+                c = {k: num(corr[comp][k], f"{where}.{comp}.{k}", 0.0, 1.0) for k in ("a1", "a2")}
+                c.update({k: num(corr[comp][k], f"{where}.{comp}.{k}", 0.0, 1e6, lo_open=True)
+                          for k in ("tau1_s", "tau2_s")})
+                if c["a1"] + c["a2"] > 1 + 1e-9:
+                    raise NoiseModelError(f"{path}: {where}.{comp}: a1 + a2 = {c['a1'] + c['a2']:g} > 1")
+                out[comp] = c
+            return out
 
         corr = correlation(m["correlation"], ["range", "bearing"], "measurement.correlation")
         o = j["odometry"]
         keys(o, ["x", "y", "theta", "kernel", "kernel_k", "speed_scale", "turn_scale", "command_delay_s", "correlation"],
              "odometry")
-        if not isinstance(o["command_delay_s"], (int, float)) or not -2.0 <= o["command_delay_s"] <= 2.0:
-            raise NoiseModelError(f"{path}: odometry.command_delay_s: expected a number in -2..2")
-        for k in ("speed_scale", "turn_scale"):
-            if not isinstance(o[k], (int, float)) or not 0.2 <= o[k] <= 5.0:
-                raise NoiseModelError(f"{path}: odometry.{k}: expected a number in 0.2-5")
+        delay = num(o["command_delay_s"], "odometry.command_delay_s", -2.0, 2.0)
+        scales = tuple(num(o[k], f"odometry.{k}", 0.2, 5.0) for k in ("speed_scale", "turn_scale"))
         kernels = {}
-        for where, obj in (("measurement", m), ("odometry", o)):
-            if obj["kernel"] not in KERNELS:
-                raise NoiseModelError(f"{path}: {where}.kernel: {obj['kernel']!r} is not one of {', '.join(KERNELS)}")
-            kk = obj["kernel_k"]
-            if obj["kernel"] != "gaussian" and not (isinstance(kk, (int, float)) and kk > 0):
-                raise NoiseModelError(f"{path}: {where}.kernel_k: expected a number > 0 for {obj['kernel']}")
-            kernels[where] = (obj["kernel"], None if obj["kernel"] == "gaussian" else float(kk))
+        for where, obj, allowed in (("measurement", m, KERNELS), ("odometry", o, ODOM_KERNELS)):
+            if obj["kernel"] not in allowed:
+                raise NoiseModelError(f"{path}: {where}.kernel: {obj['kernel']!r} is not one of {', '.join(allowed)}")
+            if obj["kernel"] == "gaussian":
+                if obj["kernel_k"] is not None:
+                    raise NoiseModelError(f"{path}: {where}.kernel_k: must be null for the gaussian kernel")
+                kernels[where] = ("gaussian", None)
+            else:
+                kernels[where] = (obj["kernel"], num(obj["kernel_k"], f"{where}.kernel_k", K_MIN, K_MAX))
         odom = {}
         for c in ("x", "y", "theta"):
-            keys(j["odometry"][c], ["k_t", "k_d", "k_a"], f"odometry.{c}")
-            odom[c] = {}
-            for k, v in j["odometry"][c].items():
-                if not isinstance(v, (int, float)) or not v >= 0:
-                    raise NoiseModelError(f"{path}: odometry.{c}.{k}: expected a number >= 0")
-                odom[c][k] = float(v)
-        meas = {}
-        for k in ("a_r_m", "b_r", "a_b_rad", "b_b_rad_m"):
-            if not isinstance(m[k], (int, float)) or not m[k] >= 0:
-                raise NoiseModelError(f"{path}: measurement.{k}: expected a number >= 0")
-            meas[k] = float(m[k])
-        if meas["a_r_m"] == 0 or meas["a_b_rad"] == 0:
-            raise NoiseModelError(f"{path}: measurement: a_r_m and a_b_rad must be > 0")
-        return NoiseModel(meas, odom, *kernels["measurement"], *kernels["odometry"], j["provenance"],
-                          (float(o["speed_scale"]), float(o["turn_scale"])), float(o["command_delay_s"]), corr,
+            keys(o[c], ["k_t", "k_d", "k_a"], f"odometry.{c}")
+            odom[c] = {k: num(v, f"odometry.{c}.{k}", 0.0, 1e3) for k, v in o[c].items()}
+        meas = {k: num(m[k], f"measurement.{k}", 0.0, 1e3) for k in ("b_r", "b_b_rad_m")}
+        meas.update({k: num(m[k], f"measurement.{k}", 0.0, 1e3, lo_open=True) for k in ("a_r_m", "a_b_rad")})
+        return NoiseModel({k: meas[k] for k in ("a_r_m", "b_r", "a_b_rad", "b_b_rad_m")}, odom,
+                          *kernels["measurement"], *kernels["odometry"], j["provenance"], scales, delay, corr,
                           correlation(o["correlation"], ["x", "y", "theta"], "odometry.correlation"))
 
 
@@ -436,8 +454,8 @@ CORR_LAG_EDGES_S = np.geomspace(0.2, 200.0, 25)
 
 
 def residual_streams(datasets):
-    """Per (data set, landmark): times and whitened residuals (range, bearing) under `model`'s
-    sigmas are computed by the caller; here (t, r, e_r, e_b) per stream."""
+    """Per (data set, landmark) with at least two measurements: an array of rows (t, measured
+    range, e_r, e_b), the residuals against truth (whitening is the caller's)."""
     out = []
     for ds in datasets:
         by = {}
@@ -479,7 +497,6 @@ def empirical_correlation(streams, sigmas, clip=4.0):
         np.add.at(acc[:, 3], b, 0.5 * (zi[:, 0] ** 2 + zj[:, 0] ** 2))
         np.add.at(acc[:, 4], b, 0.5 * (zi[:, 1] ** 2 + zj[:, 1] ** 2))
     centres = np.sqrt(CORR_LAG_EDGES_S[:-1] * CORR_LAG_EDGES_S[1:])
-    n = np.maximum(acc[:, 0], 1.0)
     with np.errstate(invalid="ignore", divide="ignore"):
         rr = acc[:, 1] / acc[:, 3]
         rb = acc[:, 2] / acc[:, 4]

@@ -74,7 +74,8 @@ def test_mrclam_summary_combines_the_runs(tmp_path):
     import sys
     script = os.path.join(os.path.dirname(__file__), "..", "..", "scripts", "mrclam_summary.py")
     base = {"aligned_rmse_max_m": 0.1, "anees_landmarks_max": 2.0, "landmarks_min": 14, "landmarks_max": 16,
-            "parameters": {"assoc": "known"}}
+            "parameters": {"assoc": "known"}, "multi_aligned_rmse_max_m": 0.2, "multi_landmark_rmse_m": 0.3,
+            "multi_anees_landmarks": 1.0}
     for name, extra in (("known", {"multi_aligned_rmse_max_m": 0.12, "multi_landmark_rmse_m": 0.05}),
                         ("unknown", {"aligned_rmse_max_m": 0.9, "landmarks_min": 20}),
                         ("fixed-known", {"multi_landmark_rmse_m": 0.07})):
@@ -88,3 +89,35 @@ def test_mrclam_summary_combines_the_runs(tmp_path):
     (tmp_path / "mrclam-unknown.json").unlink()
     r = subprocess.run([sys.executable, script, str(tmp_path)], capture_output=True, text=True)
     assert r.returncode == 3 and "mrclam-unknown.json" in r.stderr
+    (tmp_path / "mrclam-unknown.json").write_text(json.dumps({"aligned_rmse_max_m": 1.0}) + "\n")
+    r = subprocess.run([sys.executable, script, str(tmp_path)], capture_output=True, text=True)
+    assert r.returncode == 3 and "lacks" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_cli_multi_summary_has_what_the_summary_reads(tmp_path):
+    # the keys scripts/mrclam_summary.py reads, from a real run (the fixture: robot 2, 2 minutes)
+    import json
+    import subprocess
+    import sys
+    from conftest import HERE
+    env = dict(os.environ, PYTHONPATH=os.path.dirname(HERE))
+    out = tmp_path / "s.json"
+    r = subprocess.run([sys.executable, "-m", "cylslam", "mrclam", "--dir", MR, "--robot", "2", "--multi",
+                        "--noise", "learned", "--no-plot", "--summary-out", str(out)],
+                       capture_output=True, text=True, env=env, timeout=300)
+    assert r.returncode == 0, r.stderr
+    s = json.loads(out.read_text())
+    assert s == json.loads(r.stdout.strip().splitlines()[-1])
+    for k in ("aligned_rmse_max_m", "anees_landmarks_max", "landmarks_min", "landmarks_max",
+              "multi_aligned_rmse_max_m", "multi_landmark_rmse_m", "multi_anees_landmarks", "parameters"):
+        assert s[k] is not None, k
+    assert s["parameters"]["noise"] == "learned" and s["parameters"]["robust"] == "cauchy"
+    assert s["multi_aligned_rmse_max_m"] < 0.2
+    # an output directory that does not exist: refused before the run
+    r = subprocess.run([sys.executable, "-m", "cylslam", "mrclam", "--dir", MR, "--robot", "2",
+                        "--summary-out", str(tmp_path / "no" / "s.json")], capture_output=True, text=True, env=env)
+    assert r.returncode == 4 and "no such directory" in r.stderr
+    # --noise-model without --noise learned
+    r = subprocess.run([sys.executable, "-m", "cylslam", "mrclam", "--dir", MR, "--robot", "2",
+                        "--noise-model", str(out)], capture_output=True, text=True, env=env)
+    assert r.returncode == 2 and "--noise learned" in r.stderr

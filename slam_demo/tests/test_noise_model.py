@@ -97,13 +97,30 @@ def test_model_round_trip_and_strict_reading(tmp_path):
                         (lambda j: j["measurement"].update(kernel="tukey"), "measurement.kernel"),
                         (lambda j: j["measurement"].update(kernel_k=None), "measurement.kernel_k"),
                         (lambda j: j["odometry"]["theta"].update(k_a=-1), "odometry.theta.k_a"),
-                        (lambda j: j.update(version=9), "version 1")):
+                        (lambda j: j.update(version=9), "version 1"),
+                        (lambda j: j["measurement"].update(a_r_m=float("inf")), "measurement.a_r_m"),
+                        (lambda j: j["odometry"].update(speed_scale=True), "odometry.speed_scale"),
+                        (lambda j: j["measurement"].update(kernel_k=0.01), "measurement.kernel_k"),
+                        (lambda j: j["odometry"].update(kernel="cauchy", kernel_k=2.0), "odometry.kernel"),
+                        (lambda j: j["odometry"].update(kernel_k=3.0), "odometry.kernel_k: must be null"),
+                        (lambda j: j.update(provenance=[]), "provenance"),
+                        (lambda j: j.update(extra=1), "top level: unknown key"),
+                        (lambda j: j["measurement"].update(correlation={"range": {"a1": 0.8, "tau1_s": 1, "a2": 0.5,
+                                                                                  "tau2_s": 2},
+                                                                        "bearing": {"a1": 0, "tau1_s": 1, "a2": 0,
+                                                                                    "tau2_s": 1}}),
+                         "measurement.correlation.range: a1 \\+ a2")):
         jj = json.loads(json.dumps(j))
         edit(jj)
         q = str(tmp_path / "bad.json")
         open(q, "w").write(json.dumps(jj))
         with pytest.raises(nm.NoiseModelError, match=field.replace("(", r"\(").replace(")", r"\)")):
             nm.NoiseModel.load(q)
+    # a key twice in one object
+    q = str(tmp_path / "dup.json")
+    open(q, "w").write(open(p).read().replace('"b_r":', '"a_r_m": 1, "b_r":', 1))
+    with pytest.raises(nm.NoiseModelError, match="'a_r_m' appears twice"):
+        nm.NoiseModel.load(q)
 
 
 def test_model_file_never_replaces_a_device_or_a_link(tmp_path):
@@ -155,6 +172,13 @@ def test_cli_fits_on_the_fixture_and_maps_with_the_model(tmp_path):
     assert r.returncode == 0, r.stderr
     last = json.loads(r.stdout.strip().splitlines()[-1])
     assert last["kernel"] in nm.KERNELS and last["fit_check"]["measurements"] > 100
+    # one robot: no held-out check, said so; the model is written all the same
+    os.unlink(out)
+    r = _cli("mrclam-noise", "--dir", MR, "--robots", "2", "--out", out)
+    assert r.returncode == 0 and "no held-out check" in r.stdout and os.path.exists(out), r.stderr
+    # robots the folder does not hold: a clear error, not a traceback
+    r = _cli("mrclam-noise", "--dir", MR, "--robots", "1,2")
+    assert r.returncode == 3 and "Robot1_Odometry.dat" in r.stderr and "Traceback" not in r.stderr
     r = _cli("mrclam", "--dir", MR, "--robot", "2", "--noise", "learned", "--noise-model", out, "--no-plot")
     assert r.returncode == 0, r.stderr
     assert "noise learned" in r.stdout
@@ -200,6 +224,15 @@ def test_command_delay_and_scales_are_recovered():
     assert sv == pytest.approx(0.9, abs=0.01) and sw == pytest.approx(0.8, abs=0.01)
 
 
+def test_shipped_model_round_trips(tmp_path):
+    m = nm.NoiseModel.load(nm.DEFAULT_PATH)
+    assert m.corr is not None and m.odom_corr is not None and m.cmd_delay_s > 0
+    p = str(tmp_path / "again.json")
+    m.save(p)
+    m2 = nm.NoiseModel.load(p)
+    assert m2.to_json() == m.to_json()
+
+
 def test_inflation_is_the_sum_of_correlations():
     corr = {"a1": 0.6, "tau1_s": 2.0, "a2": 0.2, "tau2_s": 20.0}
     m = nm.NoiseModel(dict(TRUE), {c: {"k_t": 0.0, "k_d": 0.0, "k_a": 0.0} for c in ("x", "y", "theta")},
@@ -209,6 +242,8 @@ def test_inflation_is_the_sum_of_correlations():
     want = [1 + rho(1) + rho(5), 1 + rho(1) + rho(4), 1 + rho(5) + rho(4)]
     f = m.inflation(t)
     assert np.allclose(f[:, 0], want) and np.allclose(f[:, 1], want)
+    # any order in, the same order out
+    assert np.allclose(m.inflation([5.0, 0.0, 1.0])[:, 0], [want[2], want[0], want[1]])
     assert np.allclose(m.odom_inflation(t)[:, 2], want)
     # a lone measurement, or no correlation model: factor 1
     assert np.allclose(m.inflation([3.0]), 1.0)
