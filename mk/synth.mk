@@ -71,6 +71,11 @@ SAN_SKIP += tests/synth/test_consistency_quick.sh:$(BUILD)
 multiband: $(BUILD)/cyl $(BUILD)/cyl-render .venv/.stamp
 	@.venv/bin/python scripts/multiband.py --build $(BUILD)
 .PHONY: multiband
+# make multirobot: three rendered robots on different paths through the multiband scene, one map
+# from their coded landmarks (scripts/multirobot.py; about 2.5 min)
+multirobot: $(BUILD)/cyl $(BUILD)/cyl-render .venv/.stamp
+	@.venv/bin/python scripts/multirobot.py --build $(BUILD)
+.PHONY: multirobot
 TEST_EXTRA_BINS += tests/synth/test_multiband_quick.sh:$(BUILD)
 # statistics, not memory safety: grouping and observing run under the sanitizers in the unit tests
 SAN_SKIP += tests/synth/test_multiband_quick.sh:$(BUILD)

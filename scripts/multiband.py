@@ -209,6 +209,19 @@ def evaluate(scene, kinds, log, truth_csv):
     return st
 
 
+def prepare(render, out):
+    """The multiband scene's file, camera, colour table (trained once) and detector config in out/:
+    (scene path, camera path, table path, config path, scene dict, kinds per landmark id)."""
+    scene_path, cam, table, cfg = (os.path.join(out, n) for n in ("scene.yaml", "camera.yaml", "multiband.cylt",
+                                                                   "detector.yaml"))
+    run([render, "-S", "multiband", "--write-scene", scene_path])
+    run([render, "-S", "multiband", "--write-camera", cam])
+    if not os.path.exists(table):
+        run([render, "-S", "multiband", "--write-table", table, "-q"])
+    scene = read_scene(scene_path)
+    return scene_path, cam, table, cfg, scene, detector_config(scene, cfg)
+
+
 def slam(python, log, out, assoc):
     env = dict(os.environ, PYTHONPATH="slam_demo")
     run([python, "-m", "cylslam", "run", log, "--out", out, "--calib-states", "--no-plot", "--no-progress",
@@ -234,15 +247,8 @@ def main():
     os.makedirs(out, exist_ok=True)
     python = sys.executable
     render = os.path.join(a.build, "cyl-render")
-    scene_path, cam, table, cfg = (os.path.join(out, n) for n in ("scene.yaml", "camera.yaml", "multiband.cylt",
-                                                                   "detector.yaml"))
     t0 = time.time()
-    run([render, "-S", "multiband", "--write-scene", scene_path])
-    run([render, "-S", "multiband", "--write-camera", cam])
-    if not os.path.exists(table):
-        run([render, "-S", "multiband", "--write-table", table, "-q"])
-    scene = read_scene(scene_path)
-    kinds = detector_config(scene, cfg)
+    scene_path, cam, table, cfg, scene, kinds = prepare(render, out)
     total = dict(whole=0, single=0, code_whole=0, id_read=0, ids=0, ids_right=0, cone_single=0, cone_conf=0,
                  nees={}, bias={})
     slam_rows = []

@@ -150,8 +150,6 @@ class Params:
                                    # times its range (its range is then far from Gaussian); None: keep
     robust: str = "none"           # none | huber | cauchy
     huber_k: float = 1.345         # the kernel's threshold k on the whitened residual (Huber or Cauchy)
-    odom_robust: str = "none"      # none | huber | cauchy: kernel on the odometry factors (a learned
-    odom_robust_k: float = 2.0     # noise model's, noise_model.py), and its threshold
     fixed_cov: Optional[np.ndarray] = None   # replaces every observation covariance (r, b order)
     anchor: str = "truth"          # truth | origin
     prior_sigmas: tuple = (1e-3, 1e-3, 1e-4)
@@ -199,21 +197,13 @@ class Slam:
         self.on_step = on_step
 
     def _odom_noise(self, cov):
-        g = gtsam.noiseModel.Gaussian.Covariance(np.asarray(cov, float))
-        if self.p.odom_robust == "cauchy":
-            return gtsam.noiseModel.Robust.Create(gtsam.noiseModel.mEstimator.Cauchy.Create(self.p.odom_robust_k), g)
-        if self.p.odom_robust == "huber":
-            return gtsam.noiseModel.Robust.Create(gtsam.noiseModel.mEstimator.Huber.Create(self.p.odom_robust_k), g)
-        if self.p.odom_robust not in ("none", "gaussian"):
-            raise ValueError(f"unknown robust kernel {self.p.odom_robust!r}")
-        return g
+        return gtsam.noiseModel.Gaussian.Covariance(np.asarray(cov, float))
 
     def _obs_noise(self, cov_rb):
         g = gtsam.noiseModel.Gaussian.Covariance(to_gtsam_cov(cov_rb))
-        if self.p.robust == "huber":
-            return gtsam.noiseModel.Robust.Create(gtsam.noiseModel.mEstimator.Huber.Create(self.p.huber_k), g)
-        if self.p.robust == "cauchy":
-            return gtsam.noiseModel.Robust.Create(gtsam.noiseModel.mEstimator.Cauchy.Create(self.p.huber_k), g)
+        kernels = {"huber": gtsam.noiseModel.mEstimator.Huber, "cauchy": gtsam.noiseModel.mEstimator.Cauchy}
+        if self.p.robust in kernels:
+            return gtsam.noiseModel.Robust.Create(kernels[self.p.robust].Create(self.p.huber_k), g)
         if self.p.robust not in ("none", "gaussian"):
             raise ValueError(f"unknown robust kernel {self.p.robust!r}")
         return g

@@ -59,23 +59,26 @@ class MultiResult:
 
 
 def run_multi(datasets, labels, params, progress=None) -> MultiResult:
-    """One map from several robots' data sets (known association; identities shared)."""
+    """One map from several robots' data sets: the observations that carry an identity, shared by
+    identity (each robot alone is first mapped with known association, or mixed where only some
+    observations carry one)."""
     t0 = time.perf_counter()
     notes = []
     singles = []
     for k, ds in enumerate(datasets):
-        p = params.__class__(**{**params.__dict__, "assoc": "known", "covariances": False,
-                                "anchor": params.anchor if k == 0 else "origin"})
+        # identities everywhere (MRCLAM), or where they were read (coded landmarks): gated elsewhere
+        p = params.__class__(**{**params.__dict__, "assoc": "known" if ds.known_ids else "mixed",
+                                "covariances": False, "anchor": params.anchor if k == 0 else "origin"})
         res = Slam(p, progress=None).run(ds)
         singles.append(res)
         if progress:
             progress(k + 1, len(datasets))
     # initial values: align each robot's own map to the map so far
-    ref = {i: res_lm for i, res_lm in zip(singles[0].lm_ids, singles[0].lms)}
+    ref = {i: res_lm for i, res_lm in zip(singles[0].lm_ids, singles[0].lms) if i is not None}
     init_poses = {0: singles[0].poses}
     for k in range(1, len(datasets)):
         res = singles[k]
-        own = {i: p for i, p in zip(res.lm_ids, res.lms)}
+        own = {i: p for i, p in zip(res.lm_ids, res.lms) if i is not None}
         common = sorted(set(own) & set(ref))
         if len(common) < 2:
             notes.append(f"{labels[k]}: shares {len(common)} landmark(s) with the map; left out")

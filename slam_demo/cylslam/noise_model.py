@@ -337,9 +337,9 @@ DEFAULT_PATH = os.path.join(os.path.dirname(__file__), "models", "mrclam_noise.j
 
 # ---- residuals against truth
 
-def measurement_residuals(ds):
-    """(r_measured, e_r, e_b) per observation of a surveyed landmark at a step with truth."""
-    out = []
+def _residual_rows(ds):
+    """(landmark id, t, measured range, e_r, e_b) per measurement of a surveyed landmark at a
+    step with truth: measured minus the range and bearing from the true pose."""
     for s in ds.steps:
         if s.truth is None:
             continue
@@ -349,9 +349,13 @@ def measurement_residuals(ds):
             if lm is None:
                 continue
             dx, dy = lm[0] - x, lm[1] - y
-            out.append((o.range_m, o.range_m - math.hypot(dx, dy),
-                        wrap(o.bearing_rad - (math.atan2(dy, dx) - th))))
-    return np.array(out, float).reshape(-1, 3)
+            yield (o.lm_id, s.t, o.range_m, o.range_m - math.hypot(dx, dy),
+                   wrap(o.bearing_rad - (math.atan2(dy, dx) - th)))
+
+
+def measurement_residuals(ds):
+    """(r_measured, e_r, e_b) per observation of a surveyed landmark at a step with truth."""
+    return np.array([row[2:] for row in _residual_rows(ds)], float).reshape(-1, 3)
 
 
 def odometry_residuals(ds):
@@ -459,17 +463,8 @@ def residual_streams(datasets):
     out = []
     for ds in datasets:
         by = {}
-        for s in ds.steps:
-            if s.truth is None:
-                continue
-            x, y, th = s.truth
-            for o in s.obs:
-                lm = ds.truth_landmarks.get(o.lm_id)
-                if lm is None:
-                    continue
-                dx, dy = lm[0] - x, lm[1] - y
-                by.setdefault(o.lm_id, []).append((s.t, o.range_m, o.range_m - math.hypot(dx, dy),
-                                                   wrap(o.bearing_rad - (math.atan2(dy, dx) - th))))
+        for row in _residual_rows(ds):
+            by.setdefault(row[0], []).append(row[1:])
         out.extend(np.array(v) for v in by.values() if len(v) > 1)
     return out
 

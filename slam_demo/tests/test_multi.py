@@ -121,3 +121,27 @@ def test_cli_multi_summary_has_what_the_summary_reads(tmp_path):
     r = subprocess.run([sys.executable, "-m", "cylslam", "mrclam", "--dir", MR, "--robot", "2",
                         "--noise-model", str(out)], capture_output=True, text=True, env=env)
     assert r.returncode == 2 and "--noise learned" in r.stderr
+
+
+def test_robots_with_identities_on_some_observations_only():
+    # as with coded and plain landmarks: every other observation without its identity; each robot
+    # alone is mapped with mixed association, and the one map takes the observations with one
+    ds = mrclam.read_mrclam(MR, 2)
+    a, b = _halves(ds, len(ds.steps) // 2)
+    out = []
+    for d in (a, b):
+        k = 0
+        steps = []
+        for s in d.steps:
+            obs = []
+            for o in s.obs:
+                obs.append(o if k % 2 == 0 else dataclasses.replace(o, lm_id=None))
+                k += 1
+            steps.append(dataclasses.replace(s, obs=obs))
+        out.append(dataclasses.replace(d, steps=steps, known_ids=False))
+    res = run_multi(out, ["A", "B"], Params(robust="huber"))
+    assert res.robots == ["A", "B"]
+    n_id = sum(1 for d in out for s in d.steps for o in s.obs if o.lm_id is not None)
+    assert res.stats["observations_used"] == n_id
+    m = evaluate_multi(out, ["A", "B"], res)
+    assert m["joint_aligned_rmse_m"] < 0.15
