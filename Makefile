@@ -61,14 +61,33 @@ lib: $(STAMP)/debs-build
 $(LIBCYL_A): lib
 
 # Cortex-M4 firmware build: must compile cleanly with the same sources.
+M4_FLAGS := -mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -Os
 cross: $(STAMP)/debs-cross
 	$(MAKE) -C libcyl BUILD=build/m4 CC=arm-none-eabi-gcc AR=arm-none-eabi-ar \
-	  CFLAGS='-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -Os -Werror'
+	  CFLAGS='$(M4_FLAGS) -Werror'
 	@bad=$$(arm-none-eabi-nm -u libcyl/build/m4/libcyl.a | awk '{print $$2}' | \
 	  grep -E '^(malloc|calloc|realloc|free|printf|fprintf|sprintf|puts|fopen|fwrite|exit|abort)$$' | sort -u); \
 	  if [ -n "$$bad" ]; then echo "cross: libcyl.a references $$bad"; exit 1; fi
 	@arm-none-eabi-size -t libcyl/build/m4/libcyl.a | tail -1 | \
 	  awk '{printf "cross: Cortex-M4 libcyl.a text %d B, data %d B, bss %d B; no heap or stdio symbols\n", $$1, $$2, $$3}'
+	@# what a firmware keeps: libcyl/examples/firmware.c (table, segment, observe) linked bare-metal
+	@# (newlib-nano, no system calls, unused sections dropped), against an empty main
+	@$(MAKE) -C libcyl BUILD=build/m4-gc CC=arm-none-eabi-gcc AR=arm-none-eabi-ar \
+	  CFLAGS='$(M4_FLAGS) -ffunction-sections -fdata-sections -Werror' >/dev/null
+	@printf 'int main(void) { for (;;) {} }\n' > libcyl/build/m4-gc/empty.c
+	@for f in libcyl/examples/firmware.c libcyl/build/m4-gc/empty.c; do \
+	  arm-none-eabi-gcc $(M4_FLAGS) -std=c99 -Werror -Ilibcyl/include $$f -Llibcyl/build/m4-gc -lcyl -lm \
+	    --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections -o libcyl/build/m4-gc/$$(basename $$f .c).elf || exit 1; \
+	done
+	@fw=$$(arm-none-eabi-size libcyl/build/m4-gc/firmware.elf | awk 'NR==2{print $$1}'); \
+	  base=$$(arm-none-eabi-size libcyl/build/m4-gc/empty.elf | awk 'NR==2{print $$1}'); \
+	  lib=$$(arm-none-eabi-nm -S --size-sort libcyl/build/m4-gc/firmware.elf | awk '$$2 ~ /^[0-9a-f]+$$/ && $$3 ~ /[tTrR]/ {print $$4}' | \
+	    sort > libcyl/build/m4-gc/kept.txt; \
+	    for o in libcyl/build/m4-gc/*.o; do arm-none-eabi-nm --defined-only $$o | awk '{print $$3}'; done | sort -u | \
+	    comm -12 - libcyl/build/m4-gc/kept.txt > libcyl/build/m4-gc/kept_cyl.txt; \
+	    echo $$(( $$(arm-none-eabi-nm -S libcyl/build/m4-gc/firmware.elf | grep -wFf libcyl/build/m4-gc/kept_cyl.txt | \
+	    awk '{printf "0x%s+", $$2} END {print 0}') ))); \
+	  echo "cross: a firmware that loads a table, segments and observes (libcyl/examples/firmware.c) links $$fw B of text, $$((fw - base)) B more than an empty main; $$lib B of it libcyl's own"
 
 install: lib
 	$(MAKE) -C libcyl BUILD=$(HOSTLIB:libcyl/%=%) install PREFIX=$(or $(PREFIX),/usr/local)
