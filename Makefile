@@ -79,15 +79,8 @@ cross: $(STAMP)/debs-cross
 	  arm-none-eabi-gcc $(M4_FLAGS) -std=c99 -Werror -Ilibcyl/include $$f -Llibcyl/build/m4-gc -lcyl -lm \
 	    --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections -o libcyl/build/m4-gc/$$(basename $$f .c).elf || exit 1; \
 	done
-	@fw=$$(arm-none-eabi-size libcyl/build/m4-gc/firmware.elf | awk 'NR==2{print $$1}'); \
-	  base=$$(arm-none-eabi-size libcyl/build/m4-gc/empty.elf | awk 'NR==2{print $$1}'); \
-	  lib=$$(arm-none-eabi-nm -S --size-sort libcyl/build/m4-gc/firmware.elf | awk '$$2 ~ /^[0-9a-f]+$$/ && $$3 ~ /[tTrR]/ {print $$4}' | \
-	    sort > libcyl/build/m4-gc/kept.txt; \
-	    for o in libcyl/build/m4-gc/*.o; do arm-none-eabi-nm --defined-only $$o | awk '{print $$3}'; done | sort -u | \
-	    comm -12 - libcyl/build/m4-gc/kept.txt > libcyl/build/m4-gc/kept_cyl.txt; \
-	    echo $$(( $$(arm-none-eabi-nm -S libcyl/build/m4-gc/firmware.elf | grep -wFf libcyl/build/m4-gc/kept_cyl.txt | \
-	    awk '{printf "0x%s+", $$2} END {print 0}') ))); \
-	  echo "cross: a firmware that loads a table, segments and observes (libcyl/examples/firmware.c) links $$fw B of text, $$((fw - base)) B more than an empty main; $$lib B of it libcyl's own"
+	@python3 scripts/firmware_size.py libcyl/build/m4-gc/firmware.elf libcyl/build/m4-gc/empty.elf \
+	  libcyl/build/m4-gc/libcyl.a
 
 install: lib
 	$(MAKE) -C libcyl BUILD=$(HOSTLIB:libcyl/%=%) install PREFIX=$(or $(PREFIX),/usr/local)

@@ -13,8 +13,8 @@
 #define H 240
 
 static uint8_t frame[W * H * 2];            /* YUYV, filled by the camera */
-static uint8_t seg_mem[51200];              /* cyl_segment_mem_size(2048, 128) on 32-bit ARM */
-static uint8_t obs_work[16384];             /* cyl_observe_work_size() for this frame */
+static uint8_t seg_mem[51216];              /* cyl_segment_mem_size(2048, 128) on 32-bit ARM
+                                               (libcyl/examples/workspace.c prints it) */
 static cyl_colortable table;
 static cyl_observation obs[64];
 extern const uint8_t table_file[];          /* a CYLT file in flash */
@@ -34,7 +34,8 @@ int main(void)
     if (cyl_segmentation_init(&seg, seg_mem, sizeof seg_mem, 2048, 128) != CYL_OK) return 3;
     for (;;) {
         if (cyl_segment(&table, &img, 0, &seg) != CYL_OK) continue;
-        if (cyl_observe(&seg, &cam, &p, obs_work, sizeof obs_work, obs, 64, &n) == CYL_OK) n_seen = n;
+        /* the default (local) estimator needs no workspace: cyl_observe_work_size() is 0 */
+        if (cyl_observe(&seg, &cam, &p, 0, 0, obs, 64, &n) == CYL_OK) n_seen = n;
     }
 }
 

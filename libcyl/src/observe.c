@@ -248,7 +248,8 @@ cyl_status cyl_observe_groups(const cyl_segmentation *seg, const cyl_group *grou
         const cyl_group *g = &groups[gi];
         const cyl_landmark_model *m = &models[g->model];
         cyl_observation *o;
-        double sx = 0.0, sy = 0.0, vx = 0.0, vy = 0.0, total_h = 0.0;
+        const double total_h = cyl_landmark_height_m(m);
+        double sx = 0.0, sy = 0.0, vx = 0.0, vy = 0.0;
         uint32_t mask = 0, first = CYL_NONE, blob_flags = 0, nsamp = 0;
         int k;
         shape_ref sh;
@@ -257,7 +258,6 @@ cyl_status cyl_observe_groups(const cyl_segmentation *seg, const cyl_group *grou
             const uint32_t bi = g->blob[k];
             const cyl_blob *b;
             cyl_centroid_noise cn;
-            total_h += m->band_height_m[k];
             if (bi == CYL_NONE) continue;
             if (bi >= seg->n_blobs) return CYL_ERR_ARG;
             b = &seg->blobs[bi];

@@ -41,6 +41,7 @@ import numpy as np
 from .data import FLAG_NO_RANGE, FLAGS_REJECT, compose, rb_to_world, wrap
 
 PERM = np.array([[0.0, 1.0], [1.0, 0.0]])
+ROBUST_KERNELS = {"huber": gtsam.noiseModel.mEstimator.Huber, "cauchy": gtsam.noiseModel.mEstimator.Cauchy}
 
 
 def X(i):
@@ -201,10 +202,9 @@ class Slam:
 
     def _obs_noise(self, cov_rb):
         g = gtsam.noiseModel.Gaussian.Covariance(to_gtsam_cov(cov_rb))
-        kernels = {"huber": gtsam.noiseModel.mEstimator.Huber, "cauchy": gtsam.noiseModel.mEstimator.Cauchy}
-        if self.p.robust in kernels:
-            return gtsam.noiseModel.Robust.Create(kernels[self.p.robust].Create(self.p.huber_k), g)
-        if self.p.robust not in ("none", "gaussian"):
+        if self.p.robust in ROBUST_KERNELS:
+            return gtsam.noiseModel.Robust.Create(ROBUST_KERNELS[self.p.robust].Create(self.p.huber_k), g)
+        if self.p.robust != "none":
             raise ValueError(f"unknown robust kernel {self.p.robust!r}")
         return g
 
@@ -492,9 +492,10 @@ def _dim(values, key):
     return {"x": 3, "l": 2}.get(chr(sym.chr()), None) or values.atVector(key).shape[0]
 
 
-def _poses(values, n):
+def _poses(values, n, base=0):
+    """The poses X(base) .. X(base + n - 1) as an (n, 3) array."""
     out = np.empty((n, 3))
     for i in range(n):
-        q = values.atPose2(X(i))
+        q = values.atPose2(X(base + i))
         out[i] = (q.x(), q.y(), q.theta())
     return out

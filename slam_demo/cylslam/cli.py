@@ -20,7 +20,6 @@ import numpy as np
 
 EXIT_OK, EXIT_CHECK, EXIT_USAGE, EXIT_INPUT, EXIT_OUTPUT = 0, 1, 2, 3, 4
 FIXED_GRID = (0.25, 0.5, 1.0, 2.0, 4.0)
-DEFAULT_NOISE_MODEL = None   # --noise-model: the model shipped with cylslam (noise_model.DEFAULT_PATH)
 
 
 class Progress:
@@ -433,8 +432,8 @@ def cmd_mrclam(args):
             print(f"cylslam: error: {e}", file=sys.stderr)
             return EXIT_INPUT
     if args.robust is None:   # the learned model's kernel, else Huber
-        args.robust, args.huber_k = ((model.kernel if model.kernel != "gaussian" else "none", model.kernel_k or 1.0)
-                                     if model else ("huber", args.huber_k))
+        args.robust, args.huber_k = model.factor_kernel() if model else ("huber", args.huber_k)
+    datasets = []
     for rb in robots:
         try:
             ds = read_mrclam(args.dir, rb, duration=args.duration, noise=args.noise,
@@ -449,6 +448,7 @@ def cmd_mrclam(args):
         s["duration_s"] = ds.duration_s
         print_summary(s)
         rows.append((rb, s))
+        datasets.append(ds)
     print()
     print(f"MRCLAM {os.path.basename(os.path.normpath(args.dir))}, {args.assoc} association, "
           f"noise {args.noise}" + (f" ({args.noise_model})" if model else "") +
@@ -492,7 +492,7 @@ def cmd_mrclam(args):
                          "robust_k": args.huber_k if args.robust != "none" else None,
                          "odom_scale": args.odom_scale, "gate": args.gate, "new_gate": args.new_gate}
     if args.multi:
-        agg.update(multi_robot(args, model, robots))
+        agg.update(multi_robot(args, datasets, robots))
         if args.check_rmse is not None:
             if not agg["multi_aligned_rmse_max_m"] <= args.check_rmse:
                 print(f"CHECK FAILED: one map: a robot's RMSE in the joint frame is "
@@ -513,13 +513,10 @@ def cmd_mrclam(args):
     return rc
 
 
-def multi_robot(args, model, robots):
-    """All robots in one graph with shared landmarks (cylslam/multi.py); prints a table and returns
-    the multi_* keys of the last line."""
-    from .mrclam import read_mrclam
+def multi_robot(args, dss, robots):
+    """All robots in one graph with shared landmarks (cylslam/multi.py), from the data sets the
+    single-robot runs read; prints a table and returns the multi_* keys of the last line."""
     from .multi import evaluate_multi, run_multi
-    dss = [read_mrclam(args.dir, rb, duration=args.duration, noise=args.noise, odom_scale=args.odom_scale,
-                       model=model) for rb in robots]
     res = run_multi(dss, robots, _params(args, assoc="known"), progress=Progress("one map", args.progress))
     for n in res.notes:
         print(f"note: {n}")
@@ -637,8 +634,8 @@ def cmd_mrclam_noise(args):
                 row["slam"] = {}
                 for rb in test:
                     ds = read_robot(rb, m2)
-                    res = Slam(Params(assoc="known", robust=m2.kernel if m2.kernel != "gaussian" else "none",
-                                      huber_k=m2.kernel_k or 1.0)).run(ds)
+                    robust, k = m2.factor_kernel()
+                    res = Slam(Params(assoc="known", robust=robust, huber_k=k)).run(ds)
                     mm = metrics.evaluate(ds, res)
                     row["slam"][str(rb)] = {k: mm.get(k) for k in ("ate_m", "anees_landmarks", "anees_poses",
                                                                   "landmark_rmse_m")}
@@ -722,7 +719,7 @@ def build_parser():
                          "both with sigma_b = 0.01 rad and the reader's odometry sigmas; or learned: "
                          "measurement and odometry sigmas and the measurement kernel from --noise-model "
                          "(default %(default)s)")
-    sp.add_argument("--noise-model", default=DEFAULT_NOISE_MODEL,
+    sp.add_argument("--noise-model", default=None,
                     help="a model written by `mrclam-noise` (with --noise learned; default: the one fitted "
                          "on Dataset 7 and shipped with cylslam, cylslam/models/mrclam_noise.json)")
     sp.add_argument("--odom-scale", type=float, default=1.0,

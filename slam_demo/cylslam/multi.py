@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import gtsam
 import numpy as np
 
-from .backend import Information, L, Slam, X, drop_reason
+from .backend import Information, L, Slam, X, _poses, drop_reason
 from .data import between
 
 from . import metrics
@@ -122,7 +122,7 @@ def run_multi(datasets, labels, params, progress=None) -> MultiResult:
     opt = gtsam.LevenbergMarquardtOptimizer(graph, values, lp)
     est = opt.optimize()
     marg = gtsam.Marginals(graph, est)
-    poses = {labels[k]: _poses_at(est, k, len(datasets[k].steps)) for k in used}
+    poses = {labels[k]: _poses(est, len(datasets[k].steps), k * ROBOT_STRIDE) for k in used}
     lms = {i: np.array(est.atPoint2(L(i))) for i in ref}
     lm_cov = {i: marg.marginalCovariance(L(i)) for i in ref}
     stats = {"robots_used": [labels[k] for k in used], "observations_used": n_obs,
@@ -133,14 +133,6 @@ def run_multi(datasets, labels, params, progress=None) -> MultiResult:
                        info=Information(graph, est), stats=stats, notes=notes)
 
 
-def _poses_at(est, k, n):
-    out = np.empty((n, 3))
-    for i in range(n):
-        q = est.atPose2(X(k * ROBOT_STRIDE + i))
-        out[i] = (q.x(), q.y(), q.theta())
-    return out
-
-
 def evaluate_multi(datasets, labels, res: MultiResult):
     """Joint-frame metrics (see the module text)."""
     idx = {lab: [i for i, s in enumerate(ds.steps) if s.truth is not None] for ds, lab in zip(datasets, labels)}
@@ -149,7 +141,7 @@ def evaluate_multi(datasets, labels, res: MultiResult):
     tru = np.vstack([np.array([by[lab].steps[i].truth for i in idx[lab]]) for lab in res.robots])
     _, joint_rmse, (R, t, ang) = metrics.ate(est, tru)
     out = {"joint_aligned_rmse_m": joint_rmse, "align_rotation_rad": ang, "robots": {}}
-    for k, lab in enumerate(res.robots):
+    for lab in res.robots:
         e = res.poses[lab][idx[lab]]
         tr = np.array([by[lab].steps[i].truth for i in idx[lab]])
         al = e[:, :2] @ R.T + t

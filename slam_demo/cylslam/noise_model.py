@@ -122,7 +122,23 @@ def log_norm(kernel, k, dim):
     return math.log(surface * (inner + outer))
 
 
-# ---- the model
+# ---- the model's two formulas, shared by the fits and the model
+
+def rb_sigmas(a_r, b_r, a_b, b_b, r):
+    """sigma_r = sqrt(a_r^2 + (b_r r)^2), sigma_b = sqrt(a_b^2 + (b_b / r)^2) at measured range r
+    (a number or an array; r below 1 mm counts as 1 mm)."""
+    r = np.maximum(np.asarray(r, float), 1e-3)
+    return np.sqrt(a_r * a_r + (b_r * r) ** 2), np.sqrt(a_b * a_b + (b_b / r) ** 2)
+
+
+def odom_variances(k, dt, d, a):
+    """Variances of the x, y, theta odometry errors, ODOM_FLOOR^2 + k_t^2 dt + (k_d d)^2 + (k_a a)^2
+    per component (k: 3x3, rows x, y, theta; dt, d, a numbers or arrays of one length: the last axis
+    of the result is the component)."""
+    k = np.asarray(k, float)
+    dt, d, a = (np.asarray(v, float)[..., None] for v in (dt, d, a))
+    return ODOM_FLOOR ** 2 + k[:, 0] ** 2 * dt + (k[:, 1] * d) ** 2 + (k[:, 2] * a) ** 2
+
 
 class NoiseModel:
     """sigma_r(r), sigma_b(r), the kernel, and the odometry sigmas (see the module text)."""
@@ -145,22 +161,23 @@ class NoiseModel:
         self.odom_corr = odom_corr
 
     def sigmas_rb(self, r):
+        """(sigma_r m, sigma_b rad) at measured range r (a number or an array)."""
         m = self.meas
-        r = max(float(r), 1e-3)
-        return (math.sqrt(m["a_r_m"] ** 2 + (m["b_r"] * r) ** 2),
-                math.sqrt(m["a_b_rad"] ** 2 + (m["b_b_rad_m"] / r) ** 2))
+        return rb_sigmas(m["a_r_m"], m["b_r"], m["a_b_rad"], m["b_b_rad_m"], r)
 
     def meas_cov(self, r, inflate=(1.0, 1.0)):
         sr, sb = self.sigmas_rb(r)
         return np.diag([sr * sr * inflate[0], sb * sb * inflate[1]])
 
+    def factor_kernel(self):
+        """(robust, k) for backend.Params (robust, huber_k): the measurement factors' kernel, "none"
+        for the Gaussian."""
+        return ("none", 1.0) if self.kernel == "gaussian" else (self.kernel, self.kernel_k)
+
     @staticmethod
     def _rho(c, dt):
         dt = np.abs(dt)
         return c["a1"] * np.exp(-dt / c["tau1_s"]) + c["a2"] * np.exp(-dt / c["tau2_s"])
-
-    def rho(self, comp, dt):
-        return self._rho(self.corr[comp], dt)
 
     @staticmethod
     def _inflation(corr, comps, times):
@@ -195,11 +212,13 @@ class NoiseModel:
         the graph then counts what the measurements know, not how many there are."""
         return self._inflation(self.corr, ("range", "bearing"), times)
 
+    def odom_k(self):
+        """The odometry parameters as a 3x3 array: rows x, y, theta; columns k_t, k_d, k_a."""
+        return np.array([[self.odom[c][k] for k in ("k_t", "k_d", "k_a")] for c in ("x", "y", "theta")])
+
     def odom_cov(self, inc, dt):
         d = math.hypot(inc[0], inc[1])
-        a = abs(inc[2])
-        return np.diag([ODOM_FLOOR ** 2 + self.odom[c]["k_t"] ** 2 * max(dt, 0.0) + (self.odom[c]["k_d"] * d) ** 2
-                         + (self.odom[c]["k_a"] * a) ** 2 for c in ("x", "y", "theta")])
+        return np.diag(odom_variances(self.odom_k(), max(dt, 0.0), d, abs(inc[2])))
 
     def to_json(self):
         return {"format": FORMAT, "version": VERSION,
@@ -358,25 +377,29 @@ def measurement_residuals(ds):
     return np.array([row[2:] for row in _residual_rows(ds)], float).reshape(-1, 3)
 
 
-def odometry_residuals(ds):
-    """(dt, d, a, e_x, e_y, e_theta) per step with truth at both ends: e = between(odometry
-    increment, true increment), the odometry's error in its own frame."""
-    out = []
+def _odometry_steps(ds):
+    """(step, its dt s, true increment) per step with odometry and truth at both ends."""
     st = ds.steps
     for k in range(1, len(st)):
-        a, b = st[k - 1].truth, st[k].truth
-        if a is None or b is None or st[k].odom is None:
-            continue
-        e = between(st[k].odom, between(a, b))
-        out.append((st[k].t - st[k - 1].t, math.hypot(st[k].odom[0], st[k].odom[1]), abs(st[k].odom[2]), *e))
-    return np.array(out, float).reshape(-1, 6)
+        if st[k - 1].truth is not None and st[k].truth is not None and st[k].odom is not None:
+            yield st[k], st[k].t - st[k - 1].t, between(st[k - 1].truth, st[k].truth)
+
+
+def odometry_residuals(ds, with_time=False):
+    """(dt, d, a, e_x, e_y, e_theta) per step with truth at both ends: e = between(odometry
+    increment, true increment), the odometry's error in its own frame; with_time: the step's time
+    in a first column."""
+    out = []
+    for s, dt, tr in _odometry_steps(ds):
+        row = (dt, math.hypot(s.odom[0], s.odom[1]), abs(s.odom[2]), *between(s.odom, tr))
+        out.append(((s.t,) if with_time else ()) + row)
+    return np.array(out, float).reshape(-1, 7 if with_time else 6)
 
 
 # ---- fitting
 
 def _meas_sigmas(p, r):
-    ar, br, ab, bb = np.exp(p[:4])
-    return np.sqrt(ar * ar + (br * r) ** 2), np.sqrt(ab * ab + (bb / r) ** 2)
+    return rb_sigmas(*np.exp(p[:4]), r)
 
 
 def meas_negloglik(p, R, kernel):
@@ -422,8 +445,7 @@ def fit_measurements(R):
 def _odom_var(p, dt, d, a):
     """Variances (N, 3) of the x, y, theta components for log-parameters p (9: k_t, k_d, k_a per
     component)."""
-    k = np.exp(np.asarray(p[:9]).reshape(3, 3))
-    return np.stack([ODOM_FLOOR ** 2 + k[c, 0] ** 2 * dt + (k[c, 1] * d) ** 2 + (k[c, 2] * a) ** 2 for c in range(3)], 1)
+    return odom_variances(np.exp(np.asarray(p[:9]).reshape(3, 3)), dt, d, a)
 
 
 def odom_negloglik(p, O, kernel):
@@ -469,33 +491,39 @@ def residual_streams(datasets):
     return out
 
 
-def empirical_correlation(streams, sigmas, clip=4.0):
-    """Correlation of whitened residuals (clipped at +-clip: the heavy tails must not decide it)
-    between measurements of one stream, by lag bins (CORR_LAG_EDGES_S): (lag centres, counts,
-    rho range, rho bearing)."""
+def lag_correlation(streams, n_comp):
+    """Correlation by lag bin (CORR_LAG_EDGES_S) between the samples of each stream: a stream is
+    (t (n,) sorted, z (n, n_comp)), z whitened; the pairs of one stream up to the largest lag are
+    counted. Returns (lag centres, pair counts, rho (n_comp, bins); NaN in a bin without pairs)."""
     nb = len(CORR_LAG_EDGES_S) - 1
-    acc = np.zeros((nb, 5))   # n, sum z_i z_j range, bearing, sum z^2 range, bearing
-    for st in streams:
-        t, r = st[:, 0], st[:, 1]
-        sr, sb = sigmas(r)
-        z = np.stack([np.clip(st[:, 2] / sr, -clip, clip), np.clip(st[:, 3] / sb, -clip, clip)], 1)
-        dt = np.abs(t[:, None] - t[None, :])
-        iu = np.triu_indices(len(t), 1)
-        lag = dt[iu]
-        b = np.searchsorted(CORR_LAG_EDGES_S, lag) - 1
-        ok = (b >= 0) & (b < nb)
-        b = b[ok]
-        zi, zj = z[iu[0][ok]], z[iu[1][ok]]
-        np.add.at(acc[:, 0], b, 1.0)
-        np.add.at(acc[:, 1], b, zi[:, 0] * zj[:, 0])
-        np.add.at(acc[:, 2], b, zi[:, 1] * zj[:, 1])
-        np.add.at(acc[:, 3], b, 0.5 * (zi[:, 0] ** 2 + zj[:, 0] ** 2))
-        np.add.at(acc[:, 4], b, 0.5 * (zi[:, 1] ** 2 + zj[:, 1] ** 2))
+    acc_n, acc_zz, acc_z2 = np.zeros(nb), np.zeros((n_comp, nb)), np.zeros((n_comp, nb))
+    for t, z in streams:
+        for i in range(len(t)):
+            hi = np.searchsorted(t, t[i] + CORR_LAG_EDGES_S[-1], side="right")   # bins are (lo, hi]
+            b = np.searchsorted(CORR_LAG_EDGES_S, t[i + 1:hi] - t[i]) - 1
+            ok = (b >= 0) & (b < nb)
+            b, zj = b[ok], z[i + 1:hi][ok]
+            np.add.at(acc_n, b, 1.0)
+            for c in range(n_comp):
+                np.add.at(acc_zz[c], b, z[i, c] * zj[:, c])
+                np.add.at(acc_z2[c], b, 0.5 * (z[i, c] ** 2 + zj[:, c] ** 2))
     centres = np.sqrt(CORR_LAG_EDGES_S[:-1] * CORR_LAG_EDGES_S[1:])
     with np.errstate(invalid="ignore", divide="ignore"):
-        rr = acc[:, 1] / acc[:, 3]
-        rb = acc[:, 2] / acc[:, 4]
-    return centres, acc[:, 0], rr, rb
+        return centres, acc_n, acc_zz / acc_z2
+
+
+def empirical_correlation(streams, sigmas, clip=4.0):
+    """Correlation of whitened residuals (clipped at +-clip: the heavy tails must not decide it)
+    between measurements of one stream (rows t, r, e_r, e_b), by lag bins (CORR_LAG_EDGES_S):
+    (lag centres, counts, rho range, rho bearing)."""
+    whitened = []
+    for st in streams:
+        o = np.argsort(st[:, 0], kind="stable")
+        st = st[o]
+        sr, sb = sigmas(st[:, 1])
+        whitened.append((st[:, 0], np.clip(np.stack([st[:, 2] / sr, st[:, 3] / sb], 1), -clip, clip)))
+    centres, counts, rho = lag_correlation(whitened, 2)
+    return centres, counts, rho[0], rho[1]
 
 
 def fit_correlation(centres, counts, rho_emp, terms=2):
@@ -528,37 +556,16 @@ def fit_correlation(centres, counts, rho_emp, terms=2):
 
 def odometry_correlation(datasets, model):
     """Empirical correlation by lag bin of the whitened per-step odometry errors (x, y, theta)
-    along each run: (lag centres, counts, rho per component)."""
-    nb = len(CORR_LAG_EDGES_S) - 1
-    acc = np.zeros((nb, 7))
+    along each run, clipped at +-4: (lag centres, counts, rho per component)."""
+    streams = []
     for ds in datasets:
-        st = ds.steps
-        rows = [(st[k].t, k) for k in range(1, len(st))
-                if st[k - 1].truth is not None and st[k].truth is not None and st[k].odom is not None]
-        if len(rows) < 2:
+        O = odometry_residuals(ds, with_time=True)
+        if len(O) < 2:
             continue
-        t = np.array([r[0] for r in rows])
-        z = []
-        for _, k in rows:
-            e = between(st[k].odom, between(st[k - 1].truth, st[k].truth))
-            sd = np.sqrt(np.diag(model.odom_cov(st[k].odom, st[k].t - st[k - 1].t)))
-            z.append(np.clip(e / sd, -4.0, 4.0))
-        z = np.array(z)
-        for i in range(len(t)):
-            hi = np.searchsorted(t, t[i] + CORR_LAG_EDGES_S[-1])
-            lag = t[i + 1:hi] - t[i]
-            b = np.searchsorted(CORR_LAG_EDGES_S, lag) - 1
-            ok = (b >= 0) & (b < nb)
-            b = b[ok]
-            zj = z[i + 1:hi][ok]
-            np.add.at(acc[:, 0], b, 1.0)
-            for c in range(3):
-                np.add.at(acc[:, 1 + c], b, z[i, c] * zj[:, c])
-                np.add.at(acc[:, 4 + c], b, 0.5 * (z[i, c] ** 2 + zj[:, c] ** 2))
-    centres = np.sqrt(CORR_LAG_EDGES_S[:-1] * CORR_LAG_EDGES_S[1:])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        rho = [acc[:, 1 + c] / acc[:, 4 + c] for c in range(3)]
-    return centres, acc[:, 0], rho
+        sd = np.sqrt(odom_variances(model.odom_k(), O[:, 1], O[:, 2], O[:, 3]))
+        streams.append((O[:, 0], np.clip(O[:, 4:] / sd, -4.0, 4.0)))
+    centres, counts, rho = lag_correlation(streams, 3)
+    return centres, counts, list(rho)
 
 
 def command_scales(datasets):
@@ -566,15 +573,11 @@ def command_scales(datasets):
     increments over all steps with truth (the robots drive and turn less than commanded)."""
     xo = xt = ao = at = 0.0
     for ds in datasets:
-        st = ds.steps
-        for k in range(1, len(st)):
-            if st[k - 1].truth is None or st[k].truth is None or st[k].odom is None:
-                continue
-            tr = between(st[k - 1].truth, st[k].truth)
-            xo += st[k].odom[0] ** 2
-            xt += st[k].odom[0] * tr[0]
-            ao += st[k].odom[2] ** 2
-            at += st[k].odom[2] * tr[2]
+        for s, _, tr in _odometry_steps(ds):
+            xo += s.odom[0] ** 2
+            xt += s.odom[0] * tr[0]
+            ao += s.odom[2] ** 2
+            at += s.odom[2] * tr[2]
     return xt / xo, at / ao
 
 
@@ -586,9 +589,7 @@ def _odometry_only(scales=(1.0, 1.0), delay=0.0):
 
 def heading_rms(datasets, scale):
     """RMS of the per-step heading increment error with the turn rate scaled (rad)."""
-    e = [between(st[k - 1].truth, st[k].truth)[2] - scale * st[k].odom[2]
-         for ds in datasets for st in [ds.steps] for k in range(1, len(st))
-         if st[k - 1].truth is not None and st[k].truth is not None and st[k].odom is not None]
+    e = [tr[2] - scale * s.odom[2] for ds in datasets for s, _, tr in _odometry_steps(ds)]
     return float(np.sqrt(np.mean(np.square(e))))
 
 
@@ -637,8 +638,7 @@ def fit(read, source):
                          "measurement kernel by BIC (cylslam/noise_model.py)"}
     probe = NoiseModel(meas, per_o[chosen_o]["model"])
     streams = residual_streams(datasets)
-    sig = lambda r: (np.array([probe.sigmas_rb(x)[0] for x in r]), np.array([probe.sigmas_rb(x)[1] for x in r]))  # noqa: E731
-    centres, counts, rr, rb = empirical_correlation(streams, sig)
+    centres, counts, rr, rb = empirical_correlation(streams, probe.sigmas_rb)
     corr = {"range": fit_correlation(centres, counts, rr), "bearing": fit_correlation(centres, counts, rb)}
     prov["correlation_lags_s"] = [round(float(x), 3) for x in centres]
     prov["correlation_pairs"] = [int(x) for x in counts]
@@ -678,8 +678,7 @@ def check(model, datasets):
     mean and median squared whitened odometry errors per component (1 and 0.455 for a Gaussian)."""
     R = np.vstack([measurement_residuals(ds) for ds in datasets])
     O = np.vstack([odometry_residuals(ds) for ds in datasets])
-    sr = np.array([model.sigmas_rb(r)[0] for r in R[:, 0]])
-    sb = np.array([model.sigmas_rb(r)[1] for r in R[:, 0]])
+    sr, sb = model.sigmas_rb(R[:, 0])
     zr, zb = R[:, 1] / sr, R[:, 2] / sb
     s = np.hypot(zr, zb)
     r50, r95 = radius(model.kernel, model.kernel_k, 0.5), radius(model.kernel, model.kernel_k, 0.95)
@@ -688,11 +687,7 @@ def check(model, datasets):
            "within_kernel_95_radius": float(np.mean(s <= r95)),
            "range_within_1_2_3_sigma": [float(np.mean(np.abs(zr) <= q)) for q in (1, 2, 3)],
            "bearing_within_1_2_3_sigma": [float(np.mean(np.abs(zb) <= q)) for q in (1, 2, 3)]}
-    zo = []
-    for row in O:
-        cov = model.odom_cov((row[1], 0.0, row[2]), row[0])
-        zo.append(row[3:] / np.sqrt(np.diag(cov)))
-    zo = np.array(zo)
+    zo = O[:, 3:] / np.sqrt(odom_variances(model.odom_k(), O[:, 0], O[:, 1], O[:, 2]))
     out["odometry_steps"] = int(len(O))
     out["odometry_mean_z2_x_y_theta"] = [float(np.mean(zo[:, c] ** 2)) for c in range(3)]
     out["odometry_median_z2_x_y_theta"] = [float(np.median(zo[:, c] ** 2)) for c in range(3)]
