@@ -69,7 +69,7 @@ SAN_SKIP += tests/synth/test_consistency_quick.sh:$(BUILD)
 # the multiband scene: one observation per landmark, identities, range bias, SLAM with and without
 # identities (scripts/multiband.py; last line JSON); make test runs its --quick form.
 multiband: $(BUILD)/cyl $(BUILD)/cyl-render .venv/.stamp
-	@.venv/bin/python scripts/multiband.py --build $(BUILD)
+	@.venv/bin/python scripts/multiband.py --build $(BUILD) --check
 .PHONY: multiband
 # make multirobot: three rendered robots on different paths through the multiband scene, one map
 # from their coded landmarks (scripts/multirobot.py; about 2.5 min)

@@ -26,6 +26,12 @@ diagonal on the floor) nearer the camera within its angular extent. Figures:
                            with gating alone (unknown), from cylslam's summary.
 The drives use the scene's true camera (no calibration error): the range bias is the pipeline's.
 Last line: JSON. --quick (make test): one seed, 150 frames, no SLAM comparison of many frames.
+--check (make multiband): exit 1, naming each one missed, unless single_observation_frac >= 0.95,
+id_correct_frac >= 0.99, id_wrong_confident_frac <= 0.005, range_bias_rel_max <= 0.01, no association
+error with identities, the ATE with identities <= the gated one on every drive, and
+cone_confidence_frac >= 0.9.
+Exit codes: 0 ran (and, with --check, met every target), 1 a tool failed or a target was missed,
+2 bad command line.
 """
 import argparse
 import csv
@@ -239,6 +245,7 @@ def main():
                     help="drives to judge (default 101-103: never used for a choice)")
     ap.add_argument("--frames", type=int, default=700)
     ap.add_argument("--quick", action="store_true", help="seed 101, 150 frames (make test)")
+    ap.add_argument("--check", action="store_true", help="exit 1 unless every target above is met")
     ap.add_argument("--version", action="version", version="multiband.py (libcyl project)")
     a = ap.parse_args()
     if a.quick:
@@ -315,7 +322,27 @@ def main():
         "seconds": round(time.time() - t0, 1),
     }
     print(json.dumps(res))
+    if a.check:
+        missed = check(res)
+        for m in missed:
+            sys.stderr.write(f"multiband: target missed: {m}\n")
+        return 1 if missed else 0
+    return 0
+
+
+def check(res):
+    """The targets a landmark-model pipeline must meet; returns the missed ones, named."""
+    missed = []
+    for key, op, bound in (("single_observation_frac", ">=", 0.95), ("id_correct_frac", ">=", 0.99),
+                           ("id_wrong_confident_frac", "<=", 0.005), ("range_bias_rel_max", "<=", 0.01),
+                           ("slam_association_errors_with_ids", "<=", 0), ("slam_ate_with_ids_le_gated_frac", ">=", 1.0),
+                           ("cone_confidence_frac", ">=", 0.9)):
+        v = res.get(key)
+        ok = isinstance(v, (int, float)) and not math.isnan(v) and (v >= bound if op == ">=" else v <= bound)
+        if not ok:
+            missed.append(f"{key} {v} (target {op} {bound})")
+    return missed
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -145,3 +145,22 @@ def test_robots_with_identities_on_some_observations_only():
     assert res.stats["observations_used"] == n_id
     m = evaluate_multi(out, ["A", "B"], res)
     assert m["joint_aligned_rmse_m"] < 0.15
+
+
+def test_multiband_check_names_each_missed_target():
+    # scripts/multiband.py --check: the targets of make multiband, each missed one named
+    import importlib.util
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "scripts", "multiband.py")
+    spec = importlib.util.spec_from_file_location("multiband_script", path)
+    mb = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mb)
+    good = {"single_observation_frac": 0.95, "id_correct_frac": 1.0, "id_wrong_confident_frac": 0.005,
+            "range_bias_rel_max": 0.01, "slam_association_errors_with_ids": 0,
+            "slam_ate_with_ids_le_gated_frac": 1.0, "cone_confidence_frac": 0.9}
+    assert mb.check(good) == []
+    for key, bad in (("single_observation_frac", 0.949), ("id_correct_frac", 0.98), ("id_wrong_confident_frac", 0.006),
+                     ("range_bias_rel_max", 0.0101), ("range_bias_rel_max", float("nan")),
+                     ("slam_association_errors_with_ids", 1), ("slam_ate_with_ids_le_gated_frac", 0.667),
+                     ("cone_confidence_frac", 0.89), ("cone_confidence_frac", None)):
+        missed = mb.check({**good, key: bad})
+        assert len(missed) == 1 and missed[0].startswith(key), (key, bad, missed)

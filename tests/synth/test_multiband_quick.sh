@@ -5,14 +5,15 @@
 # identities). Asserts the figures the full form is judged on: one observation per landmark wholly
 # in view (>= 0.95), identities right (>= 0.99 of those read, <= 0.005 wrong), grouped ranges
 # unbiased within 1% over 1-4 m, cones confident (>= 0.9 at >= 0.8), no association error with
-# identities and an ATE no worse than gating's. GoogleTest-style lines.
+# identities and an ATE no worse than gating's (multiband.py --check, where the targets are written
+# once), on enough views and identities to judge. GoogleTest-style lines.
 #   test_multiband_quick.sh BUILD_DIR
 set -u
 B=$1
 cd "$(dirname "$0")/../.."
 T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
 echo "[ RUN      ] multiband.quick"
-if ! .venv/bin/python scripts/multiband.py --quick --build "$B" --out "$T/m" >"$T/log" 2>"$T/err"; then
+if ! .venv/bin/python scripts/multiband.py --quick --check --build "$B" --out "$T/m" >"$T/log" 2>"$T/err"; then
   echo "  multiband.py failed: $(tail -5 "$T/err")"; echo "[  FAILED  ] multiband.quick"; exit 1
 fi
 msg=$(.venv/bin/python - "$T/log" <<'PY'
@@ -20,13 +21,7 @@ import json, sys
 r = json.loads(open(sys.argv[1]).read().strip().splitlines()[-1])
 bad = []
 if r["landmark_views_whole"] < 100: bad.append(f"only {r['landmark_views_whole']} whole views")
-if r["single_observation_frac"] < 0.95: bad.append(f"single_observation_frac {r['single_observation_frac']}")
-if r["ids_read"] < 50 or r["id_correct_frac"] < 0.99: bad.append(f"ids {r['ids_read']} right {r['id_correct_frac']}")
-if r["id_wrong_confident_frac"] > 0.005: bad.append(f"id_wrong_confident_frac {r['id_wrong_confident_frac']}")
-if not r["range_bias_rel_max"] <= 0.01: bad.append(f"range_bias_rel_max {r['range_bias_rel_max']}")
-if r["cone_confidence_frac"] < 0.9: bad.append(f"cone_confidence_frac {r['cone_confidence_frac']}")
-if r["slam_association_errors_with_ids"] != 0: bad.append(f"association errors {r['slam_association_errors_with_ids']}")
-if r["slam_ate_with_ids_le_gated_frac"] < 1: bad.append(f"ATE with ids {r['slam_ate_with_ids_m']} > gated {r['slam_ate_gated_m']}")
+if r["ids_read"] < 50: bad.append(f"only {r['ids_read']} identities read")
 print("; ".join(bad))
 PY
 )
