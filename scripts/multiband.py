@@ -246,6 +246,8 @@ def main():
     ap.add_argument("--frames", type=int, default=700)
     ap.add_argument("--quick", action="store_true", help="seed 101, 150 frames (make test)")
     ap.add_argument("--check", action="store_true", help="exit 1 unless every target above is met")
+    ap.add_argument("--edges", choices=["subpixel", "table"], default="subpixel",
+                    help="cyl detect --edges (default subpixel, cyl detect's own default)")
     ap.add_argument("--version", action="version", version="multiband.py (libcyl project)")
     a = ap.parse_args()
     if a.quick:
@@ -269,7 +271,7 @@ def main():
         sys.stderr.write(f"multiband: seed {seed} ({i + 1}/{len(a.seeds)}): render, detect, map\n")
         run([render, "-S", "multiband", "-s", str(seed), "-n", str(a.frames), "-o", raw, "--labels", lab, "-q"])
         run([os.path.join(a.build, "cyl"), "detect", raw, "--table", table, "--calib", cam, "--config", cfg,
-             "--out", log, "--quiet"])
+             "--edges", a.edges, "--out", log, "--quiet"])
         os.remove(raw)
         for sub in ("images", "labels"):   # the truth boxes are in truth.csv
             p = os.path.join(lab, sub)

@@ -355,6 +355,8 @@ void ObservationLog::frame(uint64_t seq, int64_t t_ns, const std::vector<cyl_obs
         cf += num(o.cov_rb_frame[1][1]);
         l.raw("jac_calib", jm + "]").raw("cov_frame", cf + "]");
         l.raw("bias_var_px2", "[" + num(o.bias_var_u_px2) + "," + num(o.bias_var_v_px2) + "]");
+        if (o.subpixel_du_px != 0.0 || o.subpixel_dv_px != 0.0)
+            l.raw("subpixel_shift_px", "[" + num(o.subpixel_du_px) + "," + num(o.subpixel_dv_px) + "]");
         write(l.done());
     }
     std::fflush(f_);

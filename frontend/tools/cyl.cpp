@@ -73,6 +73,12 @@ const char *kUsage =
     "  --estimator image|local|column|uniform   centroid variance estimator (default image: from the\n"
     "                       frame's own noise and the table's boundary; local/column/uniform: the\n"
     "                       paper's eqs. 6/5/4, from the blob's shape only)\n"
+    "  --edges subpixel|table   where a blob's edges lie (default subpixel: where the colour is halfway\n"
+    "                       between the landmark's and the background's, so a shaded side does not move\n"
+    "                       the centroid; table: where the colour table cut it)\n"
+    "  --silhouette-sigma U,V   what the silhouette model and the edges leave of the centroid's bias,\n"
+    "                       px (default 0.05,0.125 with sub-pixel edges, 0.25,0.25 with the table's;\n"
+    "                       measure your camera's, docs/uncertainty.md)\n"
     "  --size CLASS=D,H     physical landmark size of a class in m (diameter, height), repeatable;\n"
     "                       needed for confidence (synthetic default: the scene's)\n"
     "  --centroid-var-floor PX2   lower bound on each centroid variance, px^2 (default 0): a\n"
@@ -104,10 +110,11 @@ const char *kUsage =
     "            2 bad command line, 130 interrupted (outputs closed cleanly)\n";
 
 struct Args {
-    std::string cmd, source, table, calib, out = "-", overlay, model = "exact", estimator = "image";
+    std::string cmd, source, table, calib, out = "-", overlay, model = "exact", estimator = "image", edges = "subpixel";
     std::string config, roi, mask;
     std::vector<std::string> sizes, controls, min_area, max_area, merge_gap, size_gate;
     double var_floor_px2 = 0.0;
+    std::string silhouette_sigma;
     uint64_t max_frames = 0;
     bool show = false, quiet = false, fixed_exposure = false, lenient = false;
     SourceOptions src;
@@ -155,6 +162,8 @@ Args parse(int argc, char **argv)
         else if (s == "--out" || s == "-o") a.out = val(s);
         else if (s == "--model") a.model = val(s);
         else if (s == "--estimator") a.estimator = val(s);
+        else if (s == "--edges") a.edges = val(s);
+        else if (s == "--silhouette-sigma") a.silhouette_sigma = val(s);
         else if (s == "--size") a.sizes.push_back(val(s));
         else if (s == "--config") a.config = val(s);
         else if (s == "--roi") a.roi = val(s);
@@ -314,6 +323,7 @@ int cmd_detect(const Args &a)
     cyl_noise_estimator est;
     if (!parse_model(a.model, &model)) usage_error("--model: exact or paper, got '" + a.model + "'");
     if (!parse_estimator(a.estimator, &est)) usage_error("--estimator: image, local, column or uniform, got '" + a.estimator + "'");
+    if (a.edges != "subpixel" && a.edges != "table") usage_error("--edges: subpixel or table, got '" + a.edges + "'");
     if (a.show) {  // without a display Qt aborts the process (exit 134) inside cv::imshow
         const char *d = std::getenv("DISPLAY"), *w = std::getenv("WAYLAND_DISPLAY");
         if ((!d || !*d) && (!w || !*w))
@@ -331,6 +341,23 @@ int cmd_detect(const Args &a)
     apply_clutter_options(a, table, table_path, cfg);
     cfg.observe.model = model;
     cfg.observe.estimator = est;
+    if (a.edges == "table") {   // the blob's own edges, with libcyl's sigmas for them
+        const cyl_observe_params d = cyl_observe_params_default();
+        cfg.observe.subpixel = 0;
+        cfg.observe.silhouette_sigma_u_px = d.silhouette_sigma_u_px;
+        cfg.observe.silhouette_sigma_v_px = d.silhouette_sigma_v_px;
+        cfg.observe.group_silhouette_sigma_u_px = d.group_silhouette_sigma_u_px;
+        cfg.observe.group_silhouette_sigma_v_px = d.group_silhouette_sigma_v_px;
+    }
+    if (!a.silhouette_sigma.empty()) {
+        const size_t comma = a.silhouette_sigma.find(',');
+        if (comma == std::string::npos) usage_error("--silhouette-sigma: expected U,V in px, got '" + a.silhouette_sigma + "'");
+        const double su = parse_double("--silhouette-sigma", a.silhouette_sigma.substr(0, comma));
+        const double sv = parse_double("--silhouette-sigma", a.silhouette_sigma.substr(comma + 1));
+        if (!(su >= 0 && sv >= 0 && su < 100 && sv < 100)) usage_error("--silhouette-sigma: each must be 0..100 px");
+        cfg.observe.silhouette_sigma_u_px = su;
+        cfg.observe.silhouette_sigma_v_px = sv;
+    }
     cfg.observe.min_var_px2 = a.var_floor_px2;
     cyl_camera cam;
     if (!a.calib.empty()) {

@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "cyl/image.h"
+#include "cyl/segment.h"
 
 /* Little-endian field access for the file formats (host-order independent). */
 static inline void cyl_put_u16(uint8_t *p, uint16_t v) { p[0] = (uint8_t)v; p[1] = (uint8_t)(v >> 8); }
@@ -57,6 +58,33 @@ static inline void cyl_pixel_fetch(const cyl_image *img, uint32_t x, uint32_t y,
         return;
     }
     *Y = *U = *V = 0;
+}
+
+/* A segmentation's sampling grid: image coordinate = grid cell * step + remainder, and the grid
+ * columns and rows it sampled. */
+typedef struct cyl_grid {
+    uint32_t sx, sy;           /* grid steps, px */
+    uint32_t rx, ry;           /* remainders, px */
+    int32_t gx_lo, gx_hi;      /* sampled grid columns */
+    int32_t gy_lo, gy_hi;      /* sampled grid rows */
+} cyl_grid;
+
+/* The grid of seg, which must have been made from a frame of img's size: 0 if it was not (or its
+ * steps are 0), 1 with *g filled. */
+static inline int cyl_grid_of(const cyl_segmentation *seg, const cyl_image *img, cyl_grid *g)
+{
+    if (seg->frame_width != img->width || seg->frame_height != img->height || seg->x_last >= img->width ||
+        seg->y_last >= img->height || seg->x_step == 0 || seg->y_step == 0)
+        return 0;
+    g->sx = seg->x_step;
+    g->sy = seg->y_step;
+    g->rx = seg->x_origin % g->sx;
+    g->ry = seg->y_origin % g->sy;
+    g->gx_lo = (int32_t)(seg->x_origin / g->sx);
+    g->gx_hi = (int32_t)(seg->x_last / g->sx);
+    g->gy_lo = (int32_t)(seg->y_origin / g->sy);
+    g->gy_hi = (int32_t)(seg->y_last / g->sy);
+    return 1;
 }
 
 #endif

@@ -23,10 +23,7 @@ typedef struct img_ctx {
     const cyl_run *runs;
     const cyl_image *img;
     const cyl_colortable *t;
-    uint32_t sx, sy;       /* grid steps */
-    uint32_t rx, ry;       /* image coordinate = grid * step + remainder */
-    int32_t gx_lo, gx_hi;  /* sampled grid columns */
-    int32_t gy_lo, gy_hi;  /* sampled grid rows */
+    cyl_grid g;            /* the sampling grid */
     uint8_t cls;
     int sub_h, sub_v;      /* chroma subsampled horizontally / vertically */
     double sig[3];         /* Y, U, V noise std of the draws (the frame's, less 8-bit rounding), levels */
@@ -48,8 +45,8 @@ cyl_noise_image_params cyl_noise_image_params_default(void)
     return p;
 }
 
-static int32_t gx_of(const img_ctx *c, uint32_t i) { return (int32_t)(c->runs[i].x / c->sx); }
-static int32_t gy_of(const img_ctx *c, uint32_t i) { return (int32_t)(c->runs[i].y / c->sy); }
+static int32_t gx_of(const img_ctx *c, uint32_t i) { return (int32_t)(c->runs[i].x / c->g.sx); }
+static int32_t gy_of(const img_ctx *c, uint32_t i) { return (int32_t)(c->runs[i].y / c->g.sy); }
 
 static uint32_t mix32(uint32_t h)
 {
@@ -83,7 +80,7 @@ static uint8_t clamp_level(double v)
 
 static int in_grid(const img_ctx *c, int32_t gx, int32_t gy)
 {
-    return gx >= c->gx_lo && gx <= c->gx_hi && gy >= c->gy_lo && gy <= c->gy_hi;
+    return gx >= c->g.gx_lo && gx <= c->g.gx_hi && gy >= c->g.gy_lo && gy <= c->g.gy_hi;
 }
 
 /* The cell's mean colour, estimated from the frame: the average of the cell and its neighbours
@@ -114,7 +111,7 @@ static int edge_direction(const img_ctx *c, int32_t gx, int32_t gy)
             int32_t s = i ? 2 : -2, qx = gx + s * kDir[k][0], qy = gy + s * kDir[k][1];
             uint8_t Y, U, V;
             if (!in_grid(c, qx, qy)) { qx = gx; qy = gy; }
-            cyl_pixel_fetch(c->img, (uint32_t)qx * c->sx + c->rx, (uint32_t)qy * c->sy + c->ry, &Y, &U, &V);
+            cyl_pixel_fetch(c->img, (uint32_t)qx * c->g.sx + c->g.rx, (uint32_t)qy * c->g.sy + c->g.ry, &Y, &U, &V);
             v[i][0] = Y; v[i][1] = U; v[i][2] = V;
         }
         d = iabs(v[1][0] - v[0][0]) + iabs(v[1][1] - v[0][1]) + iabs(v[1][2] - v[0][2]);
@@ -132,12 +129,12 @@ static void mean_of_cell(const img_ctx *c, int32_t gx, int32_t gy, int dir, cell
     /* Chroma is averaged around the first cell of the cell's chroma sample (a 4:2:2 pair at full
      * resolution), so that cells sharing a chroma sample get the same chroma mean and flip together
      * in the draws, as they do in the frame. */
-    if (c->sub_h && c->sx == 1u && (((uint32_t)gx * c->sx + c->rx) & 1u) && in_grid(c, gx - 1, gy)) cgx = gx - 1;
+    if (c->sub_h && c->g.sx == 1u && (((uint32_t)gx * c->g.sx + c->g.rx) & 1u) && in_grid(c, gx - 1, gy)) cgx = gx - 1;
     for (d = -2; d <= 2; d++) {
         int32_t qx = gx + d * kDir[dir][0], qy = gy + d * kDir[dir][1];
         uint8_t Y, U, V;
         if (!in_grid(c, qx, qy)) continue;
-        cyl_pixel_fetch(c->img, (uint32_t)qx * c->sx + c->rx, (uint32_t)qy * c->sy + c->ry, &Y, &U, &V);
+        cyl_pixel_fetch(c->img, (uint32_t)qx * c->g.sx + c->g.rx, (uint32_t)qy * c->g.sy + c->g.ry, &Y, &U, &V);
         sy += Y;
         n++;
     }
@@ -146,8 +143,8 @@ static void mean_of_cell(const img_ctx *c, int32_t gx, int32_t gy, int dir, cell
         uint32_t x, y, key;
         uint8_t Y, U, V;
         if (!in_grid(c, qx, qy)) continue;
-        x = (uint32_t)qx * c->sx + c->rx;
-        y = (uint32_t)qy * c->sy + c->ry;
+        x = (uint32_t)qx * c->g.sx + c->g.rx;
+        y = (uint32_t)qy * c->g.sy + c->g.ry;
         cyl_pixel_fetch(c->img, x, y, &Y, &U, &V);
         su += U; sv += V;
         nc++;
@@ -166,8 +163,8 @@ static void mean_of_cell(const img_ctx *c, int32_t gx, int32_t gy, int dir, cell
     m->v = sv / nc;
     m->ky = sqrt(1.0 - 1.0 / n);
     m->kc = sqrt(1.0 - sw2 / ((double)nc * (double)nc));
-    m->x = (uint32_t)gx * c->sx + c->rx;
-    m->yy = (uint32_t)gy * c->sy + c->ry;
+    m->x = (uint32_t)gx * c->g.sx + c->g.rx;
+    m->yy = (uint32_t)gy * c->g.sy + c->g.ry;
 }
 
 /* Is the cell of class cls in simulated frame k? */
@@ -248,7 +245,7 @@ static void interior_noise(img_ctx *c, uint32_t first, const cyl_noise_image_par
     uint32_t i;
     int ch;
     /* chroma neighbours must be other chroma samples */
-    const int32_t cs = (c->sub_h && c->sx == 1u) ? 2 : 1;
+    const int32_t cs = (c->sub_h && c->g.sx == 1u) ? 2 : 1;
     const int32_t margin = (int32_t)c->band + 1 + cs;
     memset(&nh, 0, sizeof nh);
     for (i = first; i != CYL_NONE;) {
@@ -259,16 +256,16 @@ static void interior_noise(img_ctx *c, uint32_t first, const cyl_noise_image_par
         b -= margin;
         if (b < a) continue;
         stride = (b - a) / (int32_t)IMG_NOISE_PER_RUN + 1;
-        y = (uint32_t)row * c->sy + c->ry;
+        y = (uint32_t)row * c->g.sy + c->g.ry;
         for (gx = a, j = 0; gx <= b && j < IMG_NOISE_PER_RUN; gx += stride, j++) {
             uint8_t Y0, U0, V0, Ym, Um, Vm, Yp, Up, Vp, dummy;
-            x = (uint32_t)gx * c->sx + c->rx;
+            x = (uint32_t)gx * c->g.sx + c->g.rx;
             cyl_pixel_fetch(c->img, x, y, &Y0, &U0, &V0);
-            cyl_pixel_fetch(c->img, x - c->sx, y, &Ym, &dummy, &dummy);
-            cyl_pixel_fetch(c->img, x + c->sx, y, &Yp, &dummy, &dummy);
+            cyl_pixel_fetch(c->img, x - c->g.sx, y, &Ym, &dummy, &dummy);
+            cyl_pixel_fetch(c->img, x + c->g.sx, y, &Yp, &dummy, &dummy);
             hist_add(&nh, 0, (int)Ym - 2 * (int)Y0 + (int)Yp);
-            cyl_pixel_fetch(c->img, x - (uint32_t)cs * c->sx, y, &dummy, &Um, &Vm);
-            cyl_pixel_fetch(c->img, x + (uint32_t)cs * c->sx, y, &dummy, &Up, &Vp);
+            cyl_pixel_fetch(c->img, x - (uint32_t)cs * c->g.sx, y, &dummy, &Um, &Vm);
+            cyl_pixel_fetch(c->img, x + (uint32_t)cs * c->g.sx, y, &dummy, &Up, &Vp);
             hist_add(&nh, 1, (int)Um - 2 * (int)U0 + (int)Up);
             hist_add(&nh, 2, (int)Vm - 2 * (int)V0 + (int)Vp);
         }
@@ -294,7 +291,7 @@ static void interior_flips(img_ctx *c, uint32_t first)
     uint32_t i, k, places = 0;
     double acc = 0.0;
     const int32_t margin = (int32_t)c->band + 3;
-    const int32_t group = (c->sub_h && c->sx == 1u) ? 2 : 1;
+    const int32_t group = (c->sub_h && c->g.sx == 1u) ? 2 : 1;
     for (i = first; i != CYL_NONE;) {
         int32_t a, b, gx, stride, gy;
         uint32_t j;
@@ -306,7 +303,7 @@ static void interior_flips(img_ctx *c, uint32_t first)
         for (gx = a, j = 0; gx <= b && j < IMG_NOISE_PER_RUN; gx += stride, j++) {
             double cnt[IMG_MAX_DRAWS];
             cell_mean cm[2];
-            int32_t g0 = group == 2 ? (int32_t)(((uint32_t)gx * c->sx + c->rx) & ~1u) - (int32_t)c->rx : gx;
+            int32_t g0 = group == 2 ? (int32_t)(((uint32_t)gx * c->g.sx + c->g.rx) & ~1u) - (int32_t)c->g.rx : gx;
             int q;
             for (q = 0; q < group; q++) mean_of_cell(c, g0 + q, gy, 0, &cm[q]);
             for (k = 0; k < c->draws; k++) {
@@ -391,10 +388,10 @@ typedef struct row_index {
 
 static uint32_t row_first(const img_ctx *c, row_index *ri, int32_t row)
 {
-    uint32_t slot = (uint32_t)(row - c->gy_lo + (int32_t)IMG_WIN * 8192) % IMG_WIN;
+    uint32_t slot = (uint32_t)(row - c->g.gy_lo + (int32_t)IMG_WIN * 8192) % IMG_WIN;
     while (ri->lead != CYL_NONE && gy_of(c, ri->lead) <= row) {
         int32_t r = gy_of(c, ri->lead);
-        uint32_t s = (uint32_t)(r - c->gy_lo + (int32_t)IMG_WIN * 8192) % IMG_WIN;
+        uint32_t s = (uint32_t)(r - c->g.gy_lo + (int32_t)IMG_WIN * 8192) % IMG_WIN;
         ri->first[s] = ri->lead;
         ri->row_of[s] = r;
         while (ri->lead != CYL_NONE && gy_of(c, ri->lead) == r) ri->lead = c->runs[ri->lead].next;
@@ -511,6 +508,7 @@ cyl_status cyl_noise_blob_image(const cyl_segmentation *seg, const cyl_blob *b, 
                                 cyl_centroid_noise *out)
 {
     img_ctx c;
+    cyl_grid g;
     row_index ri;
     row_lists L;
     double ux[IMG_MAX_DRAWS], uy[IMG_MAX_DRAWS];
@@ -529,9 +527,7 @@ cyl_status cyl_noise_blob_image(const cyl_segmentation *seg, const cyl_blob *b, 
     st = cyl_image_check(img);
     if (st != CYL_OK) return st;
     if (b->cls >= CYL_MAX_CLASSES) return CYL_ERR_ARG;
-    if (seg->frame_width != img->width || seg->frame_height != img->height ||
-        seg->x_last >= img->width || seg->y_last >= img->height || seg->x_step == 0 || seg->y_step == 0)
-        return CYL_ERR_ARG;
+    if (!cyl_grid_of(seg, img, &g)) return CYL_ERR_ARG;
     /* validation, centroid, box and the fallback variance */
     st = cyl_noise_blob(seg, b, CYL_NOISE_LOCAL, NULL, 0, out);
     if (st != CYL_OK) return st;
@@ -540,14 +536,7 @@ cyl_status cyl_noise_blob_image(const cyl_segmentation *seg, const cyl_blob *b, 
     c.runs = seg->runs;
     c.img = img;
     c.t = t;
-    c.sx = seg->x_step;
-    c.sy = seg->y_step;
-    c.rx = seg->x_origin % c.sx;
-    c.ry = seg->y_origin % c.sy;
-    c.gx_lo = (int32_t)(seg->x_origin / c.sx);
-    c.gx_hi = (int32_t)(seg->x_last / c.sx);
-    c.gy_lo = (int32_t)(seg->y_origin / c.sy);
-    c.gy_hi = (int32_t)(seg->y_last / c.sy);
+    c.g = g;
     c.cls = b->cls;
     c.sub_h = img->format != CYL_FMT_YUV444P;
     c.sub_v = img->format == CYL_FMT_NV12 || img->format == CYL_FMT_I420;
@@ -556,11 +545,11 @@ cyl_status cyl_noise_blob_image(const cyl_segmentation *seg, const cyl_blob *b, 
     /* the segmentation's own run filter and this class's merging (a hand-made segmentation that
      * never went through cyl_segment has 0: every run kept) */
     c.min_run = seg->min_run_px ? seg->min_run_px : 1u;
-    c.merge_gap = seg->merge_gap_px[b->cls] < 0 ? -1 : (int32_t)((uint32_t)seg->merge_gap_px[b->cls] / c.sx);
-    c.bx0 = (int32_t)(b->x0 / c.sx);
-    c.bx1 = (int32_t)(b->x1 / c.sx);
-    c.by0 = (int32_t)(b->y0 / c.sy);
-    c.by1 = (int32_t)(b->y1 / c.sy);
+    c.merge_gap = seg->merge_gap_px[b->cls] < 0 ? -1 : (int32_t)((uint32_t)seg->merge_gap_px[b->cls] / c.g.sx);
+    c.bx0 = (int32_t)(b->x0 / c.g.sx);
+    c.bx1 = (int32_t)(b->x1 / c.g.sx);
+    c.by0 = (int32_t)(b->y0 / c.g.sy);
+    c.by1 = (int32_t)(b->y1 / c.g.sy);
     interior_noise(&c, b->first_run, p);
     interior_flips(&c, b->first_run);
     out->sigma_y = c.sig_frame[0];
@@ -568,8 +557,8 @@ cyl_status cyl_noise_blob_image(const cyl_segmentation *seg, const cyl_blob *b, 
     out->sigma_v = c.sig_frame[2];
 
     /* centroid in grid units */
-    m_x = ((out->cx_px - (double)c.rx) / (double)c.sx);
-    m_y = ((out->cy_px - (double)c.ry) / (double)c.sy);
+    m_x = ((out->cx_px - (double)c.g.rx) / (double)c.g.sx);
+    m_y = ((out->cy_px - (double)c.g.ry) / (double)c.g.sy);
     gy0 = gy_of(&c, b->first_run);
     gy1 = gy0;
     for (i = b->first_run; i != CYL_NONE; i = c.runs[i].next) gy1 = gy_of(&c, i);
@@ -581,13 +570,13 @@ cyl_status cyl_noise_blob_image(const cyl_segmentation *seg, const cyl_blob *b, 
     memset(uy, 0, sizeof uy);
     for (row = gy0 - (int32_t)c.band; row <= gy1 + (int32_t)c.band; row++) {
         uint32_t y_img, u;
-        if (row < c.gy_lo || row > c.gy_hi) continue;
+        if (row < c.g.gy_lo || row > c.g.gy_hi) continue;
         if (build_lists(&c, &ri, row, &L) < 0) {
             /* too ragged for the bounded lists: keep the local estimate */
             out->band_cells = 0;
             return CYL_OK;
         }
-        y_img = (uint32_t)row * c.sy + c.ry;
+        y_img = (uint32_t)row * c.g.sy + c.g.ry;
         u = c.sub_v ? y_img >> 1 : y_img;
         if (have_unit && u != unit) {
             acc_x += draw_variance(ux, c.draws);
@@ -604,8 +593,8 @@ cyl_status cyl_noise_blob_image(const cyl_segmentation *seg, const cyl_blob *b, 
         acc_y += draw_variance(uy, c.draws);
     }
     n2 = (double)out->n * (double)out->n;
-    out->var_x_px2 = acc_x / n2 * (double)c.sx * (double)c.sx;
-    out->var_y_px2 = acc_y / n2 * (double)c.sy * (double)c.sy;
+    out->var_x_px2 = acc_x / n2 * (double)c.g.sx * (double)c.g.sx;
+    out->var_y_px2 = acc_y / n2 * (double)c.g.sy * (double)c.g.sy;
     out->band_cells = band_cells;
     return CYL_OK;
 }

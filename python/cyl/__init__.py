@@ -221,14 +221,20 @@ class Camera:
 
 def observe(table: Table, frame: np.ndarray, fmt: str, camera: Camera,
             sizes: Optional[Dict[str, Tuple[float, float]]] = None, estimator: str = "image",
-            width: Optional[int] = None, height: Optional[int] = None, max_observations: int = 1024) -> List[dict]:
+            width: Optional[int] = None, height: Optional[int] = None, max_observations: int = 1024,
+            edges: str = "subpixel") -> List[dict]:
     """Segmentation and cyl_observe on one frame, as `cyl detect` does: one dict per observation
-    with the observation log's fields (range_m, bearing_rad, cov_rb [[rr, rb], [rb, bb]], ...)."""
+    with the observation log's fields (range_m, bearing_rad, cov_rb [[rr, rb], [rb, bb]], ...).
+    edges: "subpixel" (libcyl's defaults with the frame, cyl_observe_params_default_frame) or
+    "table" (cyl_observe_params_default: the blob's edges where the colour table cut them)."""
     img, keep = _image(frame, fmt, width, height)
     if estimator not in ESTIMATORS:
         raise ValueError(f"estimator '{estimator}': one of {sorted(ESTIMATORS)}")
+    if edges not in ("subpixel", "table"):
+        raise ValueError(f"edges '{edges}': subpixel or table")
     s = _Segmentation(table, img)
-    p = ffi.new("cyl_observe_params *", lib.cyl_observe_params_default())
+    p = ffi.new("cyl_observe_params *", lib.cyl_observe_params_default_frame() if edges == "subpixel"
+                else lib.cyl_observe_params_default())
     p.estimator = ESTIMATORS[estimator]
     for name, (d, h) in (sizes or {}).items():
         k = table.index(name)
@@ -255,6 +261,8 @@ def observe(table: Table, frame: np.ndarray, fmt: str, camera: Camera,
             "cov_frame": [o.cov_rb_frame[0][0], o.cov_rb_frame[0][1], o.cov_rb_frame[1][1]],
             "bias_var_px2": [o.bias_var_u_px2, o.bias_var_v_px2],
         })
+        if o.subpixel_du_px != 0.0 or o.subpixel_dv_px != 0.0:
+            out[-1]["subpixel_shift_px"] = [o.subpixel_du_px, o.subpixel_dv_px]
     del keep
     return out
 

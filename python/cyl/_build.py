@@ -77,13 +77,15 @@ typedef enum cyl_geom_model { CYL_GEOM_EXACT = ..., CYL_GEOM_PAPER = ... } cyl_g
 typedef struct cyl_landmark_size { double diameter_m; double height_m; } cyl_landmark_size;
 typedef struct cyl_observe_params { cyl_noise_estimator estimator; cyl_geom_model model; double min_var_px2;
                                     cyl_landmark_size size[8]; const cyl_image *image;
-                                    const cyl_colortable *table; ...; } cyl_observe_params;
+                                    const cyl_colortable *table; int subpixel; ...; } cyl_observe_params;
 typedef struct cyl_observation { uint32_t blob; uint8_t cls; uint32_t flags; uint32_t area; double u_px; double v_px;
                                  double var_u_px2; double var_v_px2; double range_m; double bearing_rad;
                                  double cov_rb[2][2]; double x_m; double y_m; double cov_xy[2][2];
                                  double confidence; double jac_calib[2][8]; double cov_rb_frame[2][2];
-                                 double bias_var_u_px2; double bias_var_v_px2; ...; } cyl_observation;
+                                 double bias_var_u_px2; double bias_var_v_px2; double subpixel_du_px;
+                                 double subpixel_dv_px; ...; } cyl_observation;
 cyl_observe_params cyl_observe_params_default(void);
+cyl_observe_params cyl_observe_params_default_frame(void);
 size_t cyl_observe_work_size(const cyl_segmentation *seg, const cyl_observe_params *p);
 cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam, const cyl_observe_params *p, void *work,
                        size_t work_size, cyl_observation *out, uint32_t cap, uint32_t *n_out);

@@ -55,6 +55,8 @@ SCHEMAS: Dict[str, dict] = {
         "jac_calib": {"type": "array", "items": NUM}, "cov_frame": {"type": "array", "items": NUM},
         "bias_var_px2": {"type": "array", "items": NUM,
                          "description": "u, v variance of the centroid's residual bias (part of cov_frame), px^2"},
+        "subpixel_shift_px": {"type": "array", "items": NUM,
+                              "description": "u, v shift of the centroid by the sub-pixel edges (in u_px, v_px), px"},
     }, ["seq", "class", "range_m", "bearing_rad", "cov_rr", "cov_rb", "cov_bb"]),
     "odom": _obj("cyl.Odometry", "pose increment since the previous one, in its frame (a BetweenFactor<Pose2>)", {
         "seq": {"type": "integer"}, "t": _n("s"), "dx_m": _n("m"), "dy_m": _n("m"), "dtheta_rad": _n("rad"),

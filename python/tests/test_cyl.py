@@ -151,5 +151,6 @@ def test_observations_equal_the_c_tools(tmp_path):
             assert g["cov_rb"][0][0] == pytest.approx(c["cov_rr"], rel=1e-8)
             assert g["cov_rb"][1][1] == pytest.approx(c["cov_bb"], rel=1e-8)
             assert g["bias_var_px2"] == pytest.approx(c["bias_var_px2"], rel=1e-8)
+            assert g["subpixel_shift_px"] == pytest.approx(c["subpixel_shift_px"], rel=1e-8, abs=1e-12)
             n += 1
     assert n >= 6

@@ -50,6 +50,7 @@ expect_exit 2 "no command given" -- "$CYL"
 expect_exit 2 "unknown option '--bogus'" -- "$CYL" detect x --bogus
 expect_exit 2 "--max-frames: expected a whole number" -- "$CYL" detect x --max-frames -3
 expect_exit 2 "--model: exact or paper" -- "$CYL" detect x --model wrong
+expect_exit 2 "--edges: subpixel or table" -- "$CYL" detect x --edges soft
 finish
 
 start record_and_info
@@ -68,6 +69,13 @@ set -- $counts
 [ "${2:-0}" -gt 0 ] || fail "no observations"
 grep -q '"type":"odom"' "$T/o.jsonl" || fail "no odometry passed through"
 grep -q '"type":"truth_landmark"' "$T/o.jsonl" || fail "no truth passed through"
+# sub-pixel edges (the default) log their shift; --edges table leaves the blob's centroid
+grep -q '"subpixel_shift_px"' "$T/o.jsonl" || fail "no subpixel_shift_px with the default edges"
+expect_exit 0 "" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB --edges table --out "$T/t.jsonl" --quiet
+grep -q '"subpixel_shift_px"' "$T/t.jsonl" && fail "subpixel_shift_px with --edges table"
+[ "$(grep -c '"type":"obs"' "$T/t.jsonl")" -eq "$(grep -c '"type":"obs"' "$T/o.jsonl")" ] || fail "--edges changed the observation count"
+expect_exit 2 "--silhouette-sigma: expected U,V" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB --silhouette-sigma 0.1 --out "$T/x.jsonl"
+expect_exit 2 "--silhouette-sigma: each must be 0..100 px" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB --silhouette-sigma 0.1,-1 --out "$T/x.jsonl"
 finish
 
 start stdout_stream

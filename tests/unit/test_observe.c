@@ -213,6 +213,8 @@ static void test_end_to_end(void **st)
         int x0 = (int)lround(u - w / 2 + 0.5), x1 = (int)lround(u + w / 2 - 0.5);
         int y0 = (int)lround(v - hh / 2 + 0.5), y1 = (int)lround(v + hh / 2 - 0.5);
         canvas_rect(&c, x0, y0, x1 - x0 + 1, y1 - y0 + 1, 90, 80, 200);
+        /* a half-mixed column left of it (U 104: not in the class), for the sub-pixel edges */
+        canvas_rect(&c, x0 - 1, y0, 1, y1 - y0 + 1, 105, 104, 164);
     }
     cap = canvas_format_size(&c, CYL_FMT_YUV444P, 0);
     buf = malloc(cap);
@@ -238,6 +240,31 @@ static void test_end_to_end(void **st)
     assert_true(obs[0].group_flags == 0 && obs[0].code_confidence == 0.0 && obs[0].z_ref_m == 0.0);
     assert_true(fabs(obs[0].u_px - seg.blobs[0].cx_px) < 1e-9);
     assert_true(fabs(obs[0].v_px - seg.blobs[0].cy_px) < 1e-9);
+    assert_true(obs[0].subpixel_du_px == 0.0 && obs[0].subpixel_dv_px == 0.0);
+    /* Sub-pixel edges: refused without the frame; with it the centroid is cyl_subpixel_centroid's
+     * (the half-mixed column moves the left edge out by half a pixel: u smaller) and the shift is
+     * recorded; cyl_observe_params_default_frame() turns them on with the image estimator. */
+    {
+        cyl_observe_params q = p, f = cyl_observe_params_default_frame();
+        cyl_subpixel_params sp2 = cyl_subpixel_params_default();
+        cyl_subpixel_result sr;
+        cyl_observation os[1];
+        uint32_t ns;
+        q.subpixel = 1;
+        assert_int_equal(cyl_observe(&seg, &cam, &q, NULL, 0, os, 1, &ns), CYL_ERR_ARG);
+        q.image = &img;
+        q.table = &t;
+        assert_int_equal(cyl_observe(&seg, &cam, &q, NULL, 0, os, 1, &ns), CYL_OK);
+        assert_int_equal(cyl_subpixel_centroid(&seg, &seg.blobs[0], &img, &t, &sp2, &sr), CYL_OK);
+        assert_true(sr.du_px < -0.003);
+        assert_true(fabs(os[0].u_px - sr.cx_px) < 1e-9 && fabs(os[0].v_px - sr.cy_px) < 1e-9);
+        assert_true(fabs(os[0].subpixel_du_px - sr.du_px) < 1e-12 && fabs(os[0].subpixel_dv_px - sr.dv_px) < 1e-12);
+        assert_true(os[0].bearing_rad > obs[0].bearing_rad);   /* further left */
+        assert_int_equal(f.estimator, CYL_NOISE_IMAGE);
+        assert_true(f.subpixel == 1 && f.silhouette_sigma_u_px == 0.05 && f.silhouette_sigma_v_px == 0.125);
+        assert_true(f.group_silhouette_sigma_u_px == 0.25 && f.group_silhouette_sigma_v_px == 0.25);
+        assert_true(p.subpixel == 0 && p.silhouette_sigma_u_px == 0.25 && p.silhouette_sigma_v_px == 0.25);
+    }
     /* The calibration's share: cov_rb_frame = the covariance with every calibration sigma zeroed
      * (fx fy cx cy and the mount), and jac_calib against central differences. */
     {

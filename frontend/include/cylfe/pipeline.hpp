@@ -34,7 +34,7 @@ struct ClassGate {
 
 struct DetectorConfig {
     cyl_segment_params segment = cyl_segment_params_default();
-    cyl_observe_params observe = cyl_observe_params_default();
+    cyl_observe_params observe = cyl_observe_params_default_frame();  // image and table set per frame
     ClassGate gate[CYL_MAX_CLASSES];
     std::vector<uint8_t> mask;   // width*height bytes, 0 = not a landmark (the robot's own body); empty: none
     uint32_t mask_width = 0, mask_height = 0;

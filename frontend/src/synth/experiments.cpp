@@ -106,7 +106,7 @@ Cylinder prototype(const Scene &base, int32_t cls)
 // ---- Detect ---------------------------------------------------------------------------------
 
 Detect::Detect(const cyl_colortable &t, const Scene &s)
-    : seg_params(cyl_segment_params_default()), obs_params(cyl_observe_params_default()), t_(&t),
+    : seg_params(cyl_segment_params_default()), obs_params(cyl_observe_params_default_frame()), t_(&t),
       w_(s.camera.width), h_(s.camera.height)
 {
     for (size_t c = 0; c < s.classes.size() && c < CYL_MAX_CLASSES; c++) {

@@ -31,6 +31,7 @@
 #include "cyl/confidence.h"
 #include "cyl/rangebearing.h"
 #include "cyl/landmark.h"
+#include "cyl/subpixel.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -50,7 +51,8 @@ extern "C" {
 #define CYL_CALIB_COUNT 8
 
 typedef struct cyl_observe_params {
-    cyl_noise_estimator estimator;              /* centroid variance estimator (default CYL_NOISE_LOCAL) */
+    cyl_noise_estimator estimator;              /* centroid variance estimator (default CYL_NOISE_LOCAL;
+                                                   CYL_NOISE_IMAGE with the frame) */
     cyl_geom_model model;                       /* geometric model (default CYL_GEOM_EXACT) */
     uint8_t class_mask;                         /* bit i: observe blobs of class i (default 0xFF) */
     uint32_t min_area;                          /* skip blobs with fewer samples (default 1) */
@@ -71,10 +73,26 @@ typedef struct cyl_observe_params {
                                                    uncut blob of a class with a size, with this
                                                    relative uncertainty (default 0.25: a prior, not
                                                    tuned); < 0: not corrected */
-    double silhouette_sigma_px;                 /* and this absolute one, px: what is not geometry
-                                                   (shading, the table's erosion, chroma subsampling;
-                                                   default 0.25, chosen on the synthetic scene's
-                                                   tuning seeds 1-20, docs/uncertainty.md) */
+    double silhouette_sigma_u_px;               /* and this absolute one, px, per axis: what is not
+                                                   geometry (shading, the table's erosion, chroma
+                                                   subsampling; default 0.25; chosen on the
+                                                   synthetic scene's tuning seeds 1-20 for the
+                                                   blob's own edges; 0.05 with sub-pixel edges,
+                                                   docs/uncertainty.md) */
+    double silhouette_sigma_v_px;               /* likewise v (default 0.25; 0.125 with sub-pixel
+                                                   edges) */
+    double group_silhouette_sigma_u_px;         /* the same for grouped landmarks
+                                                   (cyl_observe_groups), px (default 0.25 with
+                                                   either edges: on the multiband scene's tuning
+                                                   seeds the single blobs' values left grouped
+                                                   observations over-confident, docs/uncertainty.md) */
+    double group_silhouette_sigma_v_px;         /* likewise v (default 0.25) */
+    int subpixel;                               /* 1: each blob's centroid with its edges placed
+                                                   sub-pixel (cyl/subpixel.h: the shaded side's
+                                                   bias taken out); needs image and table (default
+                                                   0: the blob's centroid, as the table cut it; 1
+                                                   with the frame) */
+    cyl_subpixel_params subpixel_params;        /* default cyl_subpixel_params_default() */
 } cyl_observe_params;
 
 typedef struct cyl_observation {
@@ -88,8 +106,11 @@ typedef struct cyl_observation {
     double var_u_px2;           /* variance of u_px, px^2: the centroid's (at least min_var_px2)
                                    plus bias_var_u_px2 */
     double var_v_px2;           /* variance of v_px, px^2 */
-    double centroid_u_px;       /* the blob's centroid, column, px */
+    double centroid_u_px;       /* the blob's centroid, column, px (with params.subpixel: with its
+                                   edges placed sub-pixel, the blob's own plus subpixel_du_px) */
     double centroid_v_px;       /* the blob's centroid, row, px */
+    double subpixel_du_px;      /* the sub-pixel edges' shift of the centroid, u, px (0: none) */
+    double subpixel_dv_px;      /* likewise v, px */
     double bias_u_px;           /* silhouette bias taken out, u, px (0: none; cyl/silhouette.h) */
     double bias_v_px;           /* silhouette bias taken out, v, px (< 0: centroid above the centre) */
     double bias_var_u_px2;      /* its variance, px^2 (part of var_u_px2) */
@@ -126,6 +147,12 @@ typedef struct cyl_observation {
 
 /* The defaults above. */
 cyl_observe_params cyl_observe_params_default(void);
+
+/* The defaults for a caller that observes with the frame at hand (it sets image and table per
+ * frame, as a frontend does): cyl_observe_params_default() with the image estimator, sub-pixel
+ * edges, and the silhouette's absolute sigmas that the sub-pixel edges leave, u 0.05 px and
+ * v 0.125 px (chosen on the synthetic scene's tuning seeds 1-20, docs/uncertainty.md). */
+cyl_observe_params cyl_observe_params_default_frame(void);
 
 /* Workspace bytes cyl_observe() needs for this segmentation and parameters. */
 size_t cyl_observe_work_size(const cyl_segmentation *seg, const cyl_observe_params *p);
