@@ -267,6 +267,13 @@ static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *c
     if (p->model != CYL_GEOM_EXACT && p->model != CYL_GEOM_PAPER) return CYL_ERR_ARG;
     if (!(p->min_var_px2 >= 0.0)) return CYL_ERR_ARG;
     if ((p->estimator == CYL_NOISE_IMAGE || p->subpixel) && (!p->image || !p->table)) return CYL_ERR_ARG;
+    if (p->subpixel && (p->subpixel_params.reach < 2u || p->subpixel_params.reach > CYL_SUBPIXEL_MAX_REACH ||
+                        !(p->subpixel_params.min_contrast >= 0.0) || !isfinite(p->subpixel_params.min_contrast)))
+        return CYL_ERR_ARG;
+    /* a sigma of the silhouette's offset may be negative (no correction) but not infinite or NaN */
+    if (!isfinite(p->silhouette_rel_sigma) || !isfinite(p->silhouette_sigma_u_px) || !isfinite(p->silhouette_sigma_v_px) ||
+        !isfinite(p->group_silhouette_sigma_u_px) || !isfinite(p->group_silhouette_sigma_v_px))
+        return CYL_ERR_ARG;
     return CYL_OK;
 }
 

@@ -51,7 +51,7 @@ static void edge(sp_ctx *c, int32_t gx, int32_t gy, int32_t ix, int32_t iy)
     const int32_t R = c->reach;
     double cin[3], cout[3], d[3], dd, sum, delta;
     int32_t p, ox = gx - R * ix, oy = gy - R * iy, jx = gx + (R - 1) * ix, jy = gy + (R - 1) * iy;
-    int k;
+    int k, gaps = 0;
     c->edges++;
     if (ox < c->g.gx_lo || ox > c->g.gx_hi || oy < c->g.gy_lo || oy > c->g.gy_hi || jx < c->g.gx_lo || jx > c->g.gx_hi ||
         jy < c->g.gy_lo || jy > c->g.gy_hi)
@@ -67,7 +67,10 @@ static void edge(sp_ctx *c, int32_t gx, int32_t gy, int32_t ix, int32_t iy)
      * at -1/2 (0 for a sharp edge: R ones). Linear in the samples, so noise does not bias it, and
      * a 4:2:2 chroma pair inside the window adds the same as its two samples would. An outside
      * sample of the blob's class means this is not the blob's outer edge (a hole, a ragged end
-     * with more of the blob beyond it): the edge is left alone. */
+     * with more of the blob beyond it); more than one inside sample not of the class means the
+     * blob is thinner than the window there (the far inside sample is another part of it across
+     * a gap): either way the edge is left alone. One is allowed: noise leaves single-sample
+     * holes in a landmark. */
     sum = 1.0;                                   /* p = R - 1: the inside colour itself */
     for (p = -R; p <= R - 2; p++) {
         double col[3];
@@ -77,6 +80,7 @@ static void edge(sp_ctx *c, int32_t gx, int32_t gy, int32_t ix, int32_t iy)
             fetch(c, gx + p * ix, gy + p * iy, col);
         }
         if (p < 0 && of_class(c, col)) return;
+        if (p >= 0 && !of_class(c, col) && ++gaps > 1) return;
         if (p > -R)
             sum += ((col[0] - cout[0]) * d[0] + (col[1] - cout[1]) * d[1] + (col[2] - cout[2]) * d[2]) / dd;
     }
@@ -139,13 +143,14 @@ cyl_status cyl_subpixel_centroid(const cyl_segmentation *seg, const cyl_blob *b,
     double n = 0.0, sxm = 0.0, sym = 0.0, hx, hy, m0;
     cyl_status st;
     if (!seg || !b || !img || !t || !p || !out) return CYL_ERR_ARG;
-    if (p->reach < 1u || p->reach > CYL_SUBPIXEL_MAX_REACH || !(p->min_contrast >= 0.0) || !isfinite(p->min_contrast))
+    if (p->reach < 2u || p->reach > CYL_SUBPIXEL_MAX_REACH || !(p->min_contrast >= 0.0) || !isfinite(p->min_contrast))
         return CYL_ERR_ARG;
     st = cyl_image_check(img);
     if (st != CYL_OK) return st;
     if (b->cls >= CYL_MAX_CLASSES) return CYL_ERR_ARG;
     if (!cyl_grid_of(seg, img, &g)) return CYL_ERR_ARG;
-    if (b->n_runs == 0 || b->first_run == CYL_NONE || b->first_run >= seg->n_runs) return CYL_ERR_EMPTY;
+    if (b->n_runs == 0 || b->first_run == CYL_NONE) return CYL_ERR_EMPTY;
+    if (b->first_run >= seg->n_runs) return CYL_ERR_ARG;
     memset(&c, 0, sizeof c);
     c.img = img;
     c.t = t;
@@ -154,6 +159,18 @@ cyl_status cyl_subpixel_centroid(const cyl_segmentation *seg, const cyl_blob *b,
     c.reach = (int32_t)p->reach;
     c.min_c2 = p->min_contrast * p->min_contrast;
 
+    /* the run chain, checked as cyl_noise_blob checks it: indices in range, rows in order, no
+     * more runs than the blob says, no empty run */
+    {
+        uint32_t cnt = 0;
+        int32_t last_y = -1;
+        for (i = b->first_run; i != CYL_NONE; i = seg->runs[i].next) {
+            if (i >= seg->n_runs || ++cnt > b->n_runs || seg->runs[i].width == 0 ||
+                (int32_t)seg->runs[i].y < last_y)
+                return CYL_ERR_ARG;
+            last_y = (int32_t)seg->runs[i].y;
+        }
+    }
     for (row_first = b->first_run; row_first != CYL_NONE;) {
         const uint32_t nxt = next_row(seg->runs, row_first);
         const int32_t y = (int32_t)seg->runs[row_first].y, gy = y / (int32_t)c.g.sy;

@@ -3,8 +3,9 @@
  * (the whole of paper section 2 in one call; docs/uncertainty.md).
  *
  * For every blob of an observed class, in the order of seg->blobs:
- *   1. measurement point = the blob's centroid (mean of its samples, px) and its variance by
- *      the chosen estimator (cyl_noise_blob). The camera height h is the height of the optical
+ *   1. measurement point = the blob's centroid (mean of its samples, px; with params.subpixel
+ *      with its edges placed sub-pixel, cyl/subpixel.h) and its variance by the chosen estimator
+ *      (cyl_noise_blob). The camera height h is the height of the optical
  *      centre above the landmark's centroid, so the ray through the blob centroid meets the
  *      plane h below the camera at the landmark's centroid height. Measured on rendered
  *      cylinders seen from above (docs/synthetic.md, "Bias of the blob centroid"): that point
@@ -63,8 +64,8 @@ typedef struct cyl_observe_params {
                                                    10 (sigma_r/r)^2; <= 0 disables) */
     cyl_landmark_size size[CYL_MAX_CLASSES];    /* physical size of each class's landmarks, m
                                                    (default 0 = unknown) */
-    /* CYL_NOISE_IMAGE only: the frame and colour table seg was made from, and the estimator's
-     * settings (cyl_noise_blob_image). Both pointers must be set for that estimator. */
+    /* CYL_NOISE_IMAGE and subpixel: the frame and colour table seg was made from, and the image
+     * estimator's settings (cyl_noise_blob_image). Both pointers must be set for either. */
     const cyl_image *image;                     /* default NULL */
     const cyl_colortable *table;                /* default NULL */
     cyl_noise_image_params image_noise;         /* default cyl_noise_image_params_default() */
