@@ -56,6 +56,13 @@ typedef struct shape_ref {
     uint32_t band_mask;
 } shape_ref;
 
+/* The silhouette offset's absolute sigmas, px: a grouped landmark's or a single blob's. */
+static void abs_sigmas(const cyl_observe_params *p, const shape_ref *sh, double *su, double *sv)
+{
+    *su = sh->model ? p->group_silhouette_sigma_u_px : p->silhouette_sigma_u_px;
+    *sv = sh->model ? p->group_silhouette_sigma_v_px : p->silhouette_sigma_v_px;
+}
+
 static cyl_status bias_of(const cyl_camera *cam, const cyl_observe_params *p, const shape_ref *sh, double x_m,
                           double y_m, cyl_silhouette_bias *sb)
 {
@@ -63,8 +70,8 @@ static cyl_status bias_of(const cyl_camera *cam, const cyl_observe_params *p, co
                                                           p->silhouette_rel_sigma, 0.0, sb)
                               : cyl_silhouette_bias_at(cam, x_m, y_m, sh->size, p->silhouette_rel_sigma, 0.0, sb);
     if (st == CYL_OK) {   /* what is not geometry, per axis */
-        const double su = sh->model ? p->group_silhouette_sigma_u_px : p->silhouette_sigma_u_px;
-        const double sv = sh->model ? p->group_silhouette_sigma_v_px : p->silhouette_sigma_v_px;
+        double su, sv;
+        abs_sigmas(p, sh, &su, &sv);
         sb->var_u_px2 += su * su;
         sb->var_v_px2 += sv * sv;
     }
@@ -144,9 +151,9 @@ static void locate(cyl_observation *o, const cyl_camera *cam, const cyl_observe_
 {
     cyl_rb_result rb;
     cyl_status st = cyl_rb_compute(cam, p->model, o->u_px, o->v_px, o->var_u_px2, o->var_v_px2, 0.0, &rb);
-    if (st == CYL_OK && p->silhouette_rel_sigma >= 0.0 &&
-        (sh->model ? (p->group_silhouette_sigma_u_px >= 0.0 && p->group_silhouette_sigma_v_px >= 0.0)
-                   : (p->silhouette_sigma_u_px >= 0.0 && p->silhouette_sigma_v_px >= 0.0)) && !(o->flags & CYL_OBS_CUT) &&
+    double su, sv;
+    abs_sigmas(p, sh, &su, &sv);
+    if (st == CYL_OK && p->silhouette_rel_sigma >= 0.0 && su >= 0.0 && sv >= 0.0 && !(o->flags & CYL_OBS_CUT) &&
         (sh->model || (sh->size->diameter_m > 0.0 && sh->size->height_m > 0.0)))
         correct_silhouette(o, cam, p, sh, &rb);
     if (st == CYL_ERR_NO_RANGE) {

@@ -100,30 +100,15 @@ static void edge(sp_ctx *c, int32_t gx, int32_t gy, int32_t ix, int32_t iy)
     }
 }
 
-/* Is grid column gx covered by a run of the row starting at list position first (CYL_NONE: none)? */
-static int covered(const cyl_run *runs, uint32_t first, int32_t row, uint32_t sx, int32_t gx)
+/* In the row whose runs start at list position *cur (a neighbouring row of the blob; CYL_NONE: not
+ * in the blob), does a run reach into grid columns lo..hi? *cur moves past the runs that end before
+ * lo, so calls with increasing lo walk the row once. */
+static int row_has(const cyl_run *runs, uint32_t *cur, int32_t row, uint32_t sx, int32_t lo, int32_t hi)
 {
-    uint32_t i;
-    for (i = first; i != CYL_NONE && (int32_t)(runs[i].y) == row; i = runs[i].next) {
-        const int32_t a = (int32_t)(runs[i].x / sx), b = a + (int32_t)runs[i].width - 1;
-        if (gx < a) return 0;
-        if (gx <= b) return 1;
-    }
-    return 0;
-}
-
-/* Does the neighbouring row (first run at list position first, CYL_NONE: not in the blob) cover
- * grid column gx, or else have a sample within reach of it? */
-static int row_ends_on_side(const sp_ctx *c, const cyl_run *runs, uint32_t first, int32_t row, int32_t gx)
-{
-    uint32_t i;
-    if (first == CYL_NONE) return 0;
-    if (covered(runs, first, row, c->g.sx, gx)) return 1;
-    for (i = first; i != CYL_NONE && (int32_t)(runs[i].y) == row; i = runs[i].next) {
-        const int32_t a = (int32_t)(runs[i].x / c->g.sx), b = a + (int32_t)runs[i].width - 1;
-        if (b >= gx - c->reach && a <= gx + c->reach) return 1;
-    }
-    return 0;
+    while (*cur != CYL_NONE && (int32_t)runs[*cur].y == row &&
+           (int32_t)(runs[*cur].x / sx) + (int32_t)runs[*cur].width - 1 < lo)
+        *cur = runs[*cur].next;
+    return *cur != CYL_NONE && (int32_t)runs[*cur].y == row && (int32_t)(runs[*cur].x / sx) <= hi;
 }
 
 static uint32_t next_row(const cyl_run *runs, uint32_t i)
@@ -177,6 +162,9 @@ cyl_status cyl_subpixel_centroid(const cyl_segmentation *seg, const cyl_blob *b,
         /* the rows above and below in the blob, when they are the neighbouring grid rows */
         const uint32_t above = (prev_first != CYL_NONE && prev_row == y - (int32_t)c.g.sy) ? prev_first : CYL_NONE;
         const uint32_t below = (nxt != CYL_NONE && (int32_t)seg->runs[nxt].y == y + (int32_t)c.g.sy) ? nxt : CYL_NONE;
+        /* cursors into the rows above and below, for the runs' starts, their cells and their ends:
+         * each is asked about columns that only grow along the row, so each walks the row once */
+        uint32_t sa = above, sb = below, ua = above, ub = below, ea = above, eb = below;
         for (i = row_first; i != nxt; i = seg->runs[i].next) {
             const int32_t a = (int32_t)(seg->runs[i].x / c.g.sx), e = a + (int32_t)seg->runs[i].width - 1;
             int32_t gx;
@@ -188,16 +176,16 @@ cyl_status cyl_subpixel_centroid(const cyl_segmentation *seg, const cyl_blob *b,
              * within reach of it is not on a side edge: it is where the blur of a top (bottom)
              * edge fades out of the class -- the top row of a landmark shaded on one side ends
              * half-way across -- and the top's own edges already place it. It is left out. */
-            ends_ok = row_ends_on_side(&c, seg->runs, above, y - (int32_t)c.g.sy, a) &&
-                      row_ends_on_side(&c, seg->runs, below, y + (int32_t)c.g.sy, a);
-            ende_ok = row_ends_on_side(&c, seg->runs, above, y - (int32_t)c.g.sy, e) &&
-                      row_ends_on_side(&c, seg->runs, below, y + (int32_t)c.g.sy, e);
+            ends_ok = row_has(seg->runs, &sa, y - (int32_t)c.g.sy, c.g.sx, a - c.reach, a + c.reach) &&
+                      row_has(seg->runs, &sb, y + (int32_t)c.g.sy, c.g.sx, a - c.reach, a + c.reach);
             if (ends_ok) edge(&c, a, gy, 1, 0);
-            if (ende_ok) edge(&c, e, gy, -1, 0);
             for (gx = a; gx <= e; gx++) {
-                if (above == CYL_NONE || !covered(seg->runs, above, y - (int32_t)c.g.sy, c.g.sx, gx)) edge(&c, gx, gy, 0, 1);
-                if (below == CYL_NONE || !covered(seg->runs, below, y + (int32_t)c.g.sy, c.g.sx, gx)) edge(&c, gx, gy, 0, -1);
+                if (!row_has(seg->runs, &ua, y - (int32_t)c.g.sy, c.g.sx, gx, gx)) edge(&c, gx, gy, 0, 1);
+                if (!row_has(seg->runs, &ub, y + (int32_t)c.g.sy, c.g.sx, gx, gx)) edge(&c, gx, gy, 0, -1);
             }
+            ende_ok = row_has(seg->runs, &ea, y - (int32_t)c.g.sy, c.g.sx, e - c.reach, e + c.reach) &&
+                      row_has(seg->runs, &eb, y + (int32_t)c.g.sy, c.g.sx, e - c.reach, e + c.reach);
+            if (ende_ok) edge(&c, e, gy, -1, 0);
         }
         prev_first = row_first;
         prev_row = y;
