@@ -81,6 +81,17 @@ cross: $(STAMP)/debs-cross
 	done
 	@python3 scripts/firmware_size.py libcyl/build/m4-gc/firmware.elf libcyl/build/m4-gc/empty.elf \
 	  libcyl/build/m4-gc/libcyl.a
+	@# the same firmware on libcyl's firmware configuration (cyl/config.h: CYL_CONFIG_FIRMWARE_MINIMAL)
+	@$(MAKE) -C libcyl BUILD=build/m4-min CC=arm-none-eabi-gcc AR=arm-none-eabi-ar \
+	  CFLAGS='$(M4_FLAGS) -Werror -DCYL_CONFIG_FIRMWARE_MINIMAL' >/dev/null
+	@arm-none-eabi-size -t libcyl/build/m4-min/libcyl.a | tail -1 | \
+	  awk '{printf "cross: Cortex-M4 libcyl.a, CYL_CONFIG_FIRMWARE_MINIMAL: text %d B, data %d B, bss %d B\n", $$1, $$2, $$3}'
+	@$(MAKE) -C libcyl BUILD=build/m4-min-gc CC=arm-none-eabi-gcc AR=arm-none-eabi-ar \
+	  CFLAGS='$(M4_FLAGS) -ffunction-sections -fdata-sections -Werror -DCYL_CONFIG_FIRMWARE_MINIMAL' >/dev/null
+	@arm-none-eabi-gcc $(M4_FLAGS) -std=c99 -Werror -Ilibcyl/include libcyl/examples/firmware.c -Llibcyl/build/m4-min-gc \
+	  -lcyl -lm --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections -o libcyl/build/m4-min-gc/firmware.elf
+	@python3 scripts/firmware_size.py libcyl/build/m4-min-gc/firmware.elf libcyl/build/m4-gc/empty.elf \
+	  libcyl/build/m4-min-gc/libcyl.a "firmware (CYL_CONFIG_FIRMWARE_MINIMAL)"
 
 install: lib
 	$(MAKE) -C libcyl BUILD=$(HOSTLIB:libcyl/%=%) install PREFIX=$(or $(PREFIX),/usr/local)

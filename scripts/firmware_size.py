@@ -3,7 +3,8 @@
 """What a firmware keeps of libcyl (`make cross`): the text of a firmware image, of an empty main
 linked the same way, and the part of the firmware's symbols that libcyl's objects define.
 
-usage: firmware_size.py FIRMWARE.elf EMPTY.elf LIBCYL.a   (arm-none-eabi-size and -nm on PATH)
+usage: firmware_size.py FIRMWARE.elf EMPTY.elf LIBCYL.a [CONFIGURATION]   (arm-none-eabi-size and -nm on PATH)
+  CONFIGURATION  words naming libcyl's compile-time configuration, for the message (default "default")
 """
 import subprocess
 import sys
@@ -16,10 +17,11 @@ def text_bytes(elf):
 
 
 def main(argv):
-    if len(argv) != 4:
+    if len(argv) not in (4, 5):
         print(__doc__.strip(), file=sys.stderr)
         return 2
-    fw, empty, lib = argv[1:]
+    fw, empty, lib = argv[1:4]
+    config = argv[4] if len(argv) == 5 else "default"
     nm = ["arm-none-eabi-nm"]
     defined = set()
     for line in subprocess.run(nm + ["--defined-only", lib], capture_output=True, text=True, check=True).stdout.splitlines():
@@ -32,8 +34,9 @@ def main(argv):
         if len(parts) == 4 and parts[2] in "tTrR" and parts[3] in defined:
             own += int(parts[1], 16)
     t_fw, t_empty = text_bytes(fw), text_bytes(empty)
-    print(f"cross: a firmware that loads a table, segments and observes (libcyl/examples/firmware.c) links "
-          f"{t_fw} B of text, {t_fw - t_empty} B more than an empty main; {own} B of it libcyl's own")
+    print(f"cross: a firmware that loads a table, segments and observes (libcyl/examples/firmware.c; libcyl's "
+          f"{config} configuration) links {t_fw} B of text, {t_fw - t_empty} B more than an empty main; "
+          f"{own} B of it libcyl's own")
     return 0
 
 

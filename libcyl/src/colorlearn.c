@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* Learning colour classes as likelihood ratios over the 3-D table (cyl/colorlearn.h). */
 #include "cyl/colorlearn.h"
+#include "cyl/config.h"
 #include "internal.h"
 #include <math.h>
 #include <string.h>
@@ -15,6 +16,7 @@ void cyl_colorhist_clear(cyl_colorhist *h)
     if (h) memset(h, 0, sizeof *h);
 }
 
+#if CYL_CONFIG_LEARN
 static double clip_channel(double x)
 {
     return x < 0.0 ? 0.0 : (x > 255.0 ? 255.0 : x);
@@ -97,6 +99,33 @@ cyl_status cyl_colorhist_add_light(cyl_colorhist *h, const cyl_image *img, const
     return CYL_OK;
 }
 
+#else /* CYL_CONFIG_LEARN */
+
+cyl_status cyl_colorhist_add_scaled(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
+                                    const uint8_t *mask, size_t mask_stride, uint8_t mask_value,
+                                    double gain)
+{
+    (void)h; (void)img; (void)roi; (void)mask; (void)mask_stride; (void)mask_value; (void)gain;
+    return CYL_ERR_UNSUPPORTED;
+}
+
+cyl_status cyl_colorhist_add_light(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
+                                   const uint8_t *mask, size_t mask_stride, uint8_t mask_value,
+                                   const double gain_rgb[3], double white_add)
+{
+    (void)h; (void)img; (void)roi; (void)mask; (void)mask_stride; (void)mask_value; (void)gain_rgb;
+    (void)white_add;
+    return CYL_ERR_UNSUPPORTED;
+}
+
+cyl_status cyl_colorhist_add(cyl_colorhist *h, const cyl_image *img, const cyl_roi *roi,
+                             const uint8_t *mask, size_t mask_stride, uint8_t mask_value)
+{
+    (void)h; (void)img; (void)roi; (void)mask; (void)mask_stride; (void)mask_value;
+    return CYL_ERR_UNSUPPORTED;
+}
+#endif /* CYL_CONFIG_LEARN */
+
 cyl_learn_params cyl_learn_params_default(void)
 {
     cyl_learn_params p;
@@ -117,6 +146,8 @@ size_t cyl_learn_workspace_size(unsigned n)
     /* background density, scratch, one likelihood-ratio array per class */
     return ((size_t)n + 2u) * K * sizeof(float);
 }
+
+#if CYL_CONFIG_LEARN
 
 /* Gaussian smoothing of a K-cell array along one axis (in place). stride: cells
  * between neighbours on the axis; len: cells on it; outer/inner: how the other
@@ -429,3 +460,14 @@ cyl_status cyl_colortable_learn(cyl_colortable *t, const cyl_learn_class *classe
     }
     return CYL_OK;
 }
+
+#else /* CYL_CONFIG_LEARN */
+
+cyl_status cyl_colortable_learn(cyl_colortable *t, const cyl_learn_class *classes, unsigned n,
+                                const cyl_colorhist *negative, const cyl_learn_params *params,
+                                void *work, size_t work_size, cyl_learn_report *reports)
+{
+    (void)t; (void)classes; (void)n; (void)negative; (void)params; (void)work; (void)work_size; (void)reports;
+    return CYL_ERR_UNSUPPORTED;
+}
+#endif

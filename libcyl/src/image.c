@@ -1,4 +1,5 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
+#include "cyl/config.h"
 #include "cyl/image.h"
 #include "internal.h"
 
@@ -16,8 +17,10 @@ static size_t row_bytes(cyl_pixfmt f, uint32_t w, int k)
     return 0;
 }
 
+/* Planes of format f; 0 for a format unknown or compiled out (CYL_CONFIG_FORMATS). */
 static int n_planes(cyl_pixfmt f)
 {
+    if ((unsigned)f > 31u || !(CYL_CONFIG_FORMATS & CYL_FORMAT_BIT(f))) return 0;
     switch (f) {
     case CYL_FMT_YUYV: case CYL_FMT_UYVY: return 1;
     case CYL_FMT_NV12: return 2;

@@ -1,40 +1,12 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- band models and the grouping of blobs into multi-colour landmarks (cyl/landmark.h). */
+#include "cyl/config.h"
 #include "cyl/landmark.h"
 
 #include <math.h>
 #include <string.h>
 
 #define DEG_TO_RAD 0.017453292519943295
-
-typedef struct cand {
-    double cost;
-    uint32_t blob[CYL_MODEL_MAX_BANDS]; /* per band, CYL_NONE for gaps and empty bands */
-    uint16_t model;
-    uint8_t n;                          /* blobs assigned */
-} cand;
-
-/* Per-model geometry derived once per call. */
-typedef struct band_geom {
-    double width_m[CYL_MODEL_MAX_BANDS];  /* widest diameter of each band, m */
-} band_geom;
-
-typedef struct grp_ctx {
-    const cyl_segmentation *seg;
-    const cyl_landmark_model *models;
-    uint32_t n_models;
-    const cyl_group_params *p;
-    double cos_d, sin_d;
-    cand *cands;
-    uint32_t n_cands, max_cands;
-    int truncated;
-    /* the assignment being built */
-    uint32_t cur[CYL_MODEL_MAX_BANDS];
-    /* restriction of the search to a set of blobs (the ambiguity check), or NULL */
-    const uint32_t *only;
-    uint32_t n_only;
-    int found;                          /* ambiguity check: an assignment using all of `only` */
-} grp_ctx;
 
 cyl_group_params cyl_group_params_default(void)
 {
@@ -48,6 +20,7 @@ cyl_group_params cyl_group_params_default(void)
     return p;
 }
 
+#if CYL_CONFIG_MODELS
 static int params_ok(const cyl_group_params *p)
 {
     return p->overlap_min >= 0.0 && p->overlap_min <= 1.0 && p->scale_tol >= 0.0 &&
@@ -93,6 +66,15 @@ cyl_status cyl_landmark_models_check(const cyl_landmark_model *models, uint32_t 
     return CYL_OK;
 }
 
+#else /* CYL_CONFIG_MODELS */
+
+cyl_status cyl_landmark_models_check(const cyl_landmark_model *models, uint32_t n_models)
+{
+    (void)models; (void)n_models;
+    return CYL_ERR_UNSUPPORTED;
+}
+#endif
+
 double cyl_landmark_height_m(const cyl_landmark_model *m)
 {
     double total = 0.0;
@@ -111,6 +93,36 @@ double cyl_landmark_diameter_at_m(const cyl_landmark_model *m, double z_m)
     if (f > 1.0) f = 1.0;
     return m->diameter_bottom_m + (m->diameter_top_m - m->diameter_bottom_m) * f;
 }
+
+#if CYL_CONFIG_MODELS
+typedef struct cand {
+    double cost;
+    uint32_t blob[CYL_MODEL_MAX_BANDS]; /* per band, CYL_NONE for gaps and empty bands */
+    uint16_t model;
+    uint8_t n;                          /* blobs assigned */
+} cand;
+
+/* Per-model geometry derived once per call. */
+typedef struct band_geom {
+    double width_m[CYL_MODEL_MAX_BANDS];  /* widest diameter of each band, m */
+} band_geom;
+
+typedef struct grp_ctx {
+    const cyl_segmentation *seg;
+    const cyl_landmark_model *models;
+    uint32_t n_models;
+    const cyl_group_params *p;
+    double cos_d, sin_d;
+    cand *cands;
+    uint32_t n_cands, max_cands;
+    int truncated;
+    /* the assignment being built */
+    uint32_t cur[CYL_MODEL_MAX_BANDS];
+    /* restriction of the search to a set of blobs (the ambiguity check), or NULL */
+    const uint32_t *only;
+    uint32_t n_only;
+    int found;                          /* ambiguity check: an assignment using all of `only` */
+} grp_ctx;
 
 static void model_geom(const cyl_landmark_model *m, band_geom *g)
 {
@@ -462,3 +474,21 @@ cyl_status cyl_group_blobs(const cyl_segmentation *seg, const cyl_landmark_model
     *n_out = n;
     return (out_full || c.truncated) ? CYL_TRUNCATED : CYL_OK;
 }
+
+#else /* CYL_CONFIG_MODELS */
+
+size_t cyl_group_work_size(uint32_t max_blobs, const cyl_group_params *p)
+{
+    (void)max_blobs; (void)p;
+    return 0;
+}
+
+cyl_status cyl_group_blobs(const cyl_segmentation *seg, const cyl_landmark_model *models,
+                           uint32_t n_models, const cyl_group_params *p, void *work,
+                           size_t work_size, cyl_group *out, uint32_t cap, uint32_t *n_out)
+{
+    (void)seg; (void)models; (void)n_models; (void)p; (void)work; (void)work_size; (void)out; (void)cap;
+    if (n_out) *n_out = 0;
+    return CYL_ERR_UNSUPPORTED;
+}
+#endif

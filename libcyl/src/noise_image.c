@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- centroid variance from the frame's own evidence (CYL_NOISE_IMAGE, cyl/noise.h). */
+#include "cyl/config.h"
 #include "cyl/noise.h"
 #include "internal.h"
 #include "lowbit.h"
@@ -7,6 +8,18 @@
 #include <math.h>
 #include <string.h>
 
+cyl_noise_image_params cyl_noise_image_params_default(void)
+{
+    cyl_noise_image_params p;
+    memset(&p, 0, sizeof p);
+    p.fallback_sigma = 2.5;
+    p.min_sigma = 0.1;
+    p.band_px = 4u;
+    p.draws = 32u;
+    return p;
+}
+
+#if CYL_CONFIG_IMAGE_ESTIMATOR
 #define IMG_MAX_IV 64      /* run intervals per row list */
 #define IMG_MAX_BAND 4u
 #define IMG_MAX_DRAWS 64u
@@ -34,16 +47,6 @@ typedef struct img_ctx {
     double v_int;          /* flip variance of an interior cell */
 } img_ctx;
 
-cyl_noise_image_params cyl_noise_image_params_default(void)
-{
-    cyl_noise_image_params p;
-    memset(&p, 0, sizeof p);
-    p.fallback_sigma = 2.5;
-    p.min_sigma = 0.1;
-    p.band_px = 4u;
-    p.draws = 32u;
-    return p;
-}
 
 static int32_t gx_of(const img_ctx *c, uint32_t i) { return (int32_t)(c->runs[i].x / c->g.sx); }
 static int32_t gy_of(const img_ctx *c, uint32_t i) { return (int32_t)(c->runs[i].y / c->g.sy); }
@@ -598,3 +601,14 @@ cyl_status cyl_noise_blob_image(const cyl_segmentation *seg, const cyl_blob *b, 
     out->band_cells = band_cells;
     return CYL_OK;
 }
+
+#else /* CYL_CONFIG_IMAGE_ESTIMATOR */
+
+cyl_status cyl_noise_blob_image(const cyl_segmentation *seg, const cyl_blob *b, const cyl_image *img,
+                                const cyl_colortable *t, const cyl_noise_image_params *p,
+                                cyl_centroid_noise *out)
+{
+    (void)seg; (void)b; (void)img; (void)t; (void)p; (void)out;
+    return CYL_ERR_UNSUPPORTED;
+}
+#endif

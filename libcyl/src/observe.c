@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- blobs to observations. */
+#include "cyl/config.h"
 #include "cyl/observe.h"
 #include "cyl/silhouette.h"
 #include "unc_internal.h"
@@ -52,8 +53,10 @@ size_t cyl_observe_work_size(const cyl_segmentation *seg, const cyl_observe_para
 typedef struct shape_ref {
     const cyl_landmark_size *size;
     const cyl_landmark_model *model;
+#if CYL_CONFIG_MODELS
     double base_z_m;
     uint32_t band_mask;
+#endif
 } shape_ref;
 
 /* The silhouette offset's absolute sigmas, px: a grouped landmark's or a single blob's. */
@@ -66,9 +69,13 @@ static void abs_sigmas(const cyl_observe_params *p, const shape_ref *sh, double 
 static cyl_status bias_of(const cyl_camera *cam, const cyl_observe_params *p, const shape_ref *sh, double x_m,
                           double y_m, cyl_silhouette_bias *sb)
 {
+#if CYL_CONFIG_MODELS
     cyl_status st = sh->model ? cyl_silhouette_bias_model(cam, x_m, y_m, sh->model, sh->base_z_m, sh->band_mask,
                                                           p->silhouette_rel_sigma, 0.0, sb)
                               : cyl_silhouette_bias_at(cam, x_m, y_m, sh->size, p->silhouette_rel_sigma, 0.0, sb);
+#else
+    cyl_status st = cyl_silhouette_bias_at(cam, x_m, y_m, sh->size, p->silhouette_rel_sigma, 0.0, sb);
+#endif
     if (st == CYL_OK) {   /* what is not geometry, per axis */
         double su, sv;
         abs_sigmas(p, sh, &su, &sv);
@@ -196,9 +203,15 @@ static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *c
 static cyl_status blob_noise(const cyl_segmentation *seg, const cyl_blob *b, const cyl_observe_params *p, void *work,
                              size_t work_size, cyl_centroid_noise *cn, double *du, double *dv)
 {
+#if CYL_CONFIG_IMAGE_ESTIMATOR
     cyl_status st = p->estimator == CYL_NOISE_IMAGE ? cyl_noise_blob_image(seg, b, p->image, p->table, &p->image_noise, cn)
                                                      : cyl_noise_blob(seg, b, p->estimator, work, work_size, cn);
+#else
+    cyl_status st = p->estimator == CYL_NOISE_IMAGE ? CYL_ERR_UNSUPPORTED
+                                                     : cyl_noise_blob(seg, b, p->estimator, work, work_size, cn);
+#endif
     *du = *dv = 0.0;
+#if CYL_CONFIG_SUBPIXEL
     if (st == CYL_OK && p->subpixel) {
         cyl_subpixel_result r;
         cyl_status s2 = cyl_subpixel_centroid(seg, b, p->image, p->table, &p->subpixel_params, &r);
@@ -211,6 +224,9 @@ static cyl_status blob_noise(const cyl_segmentation *seg, const cyl_blob *b, con
             return s2;
         }
     }
+#else
+    if (st == CYL_OK && p->subpixel) return CYL_ERR_UNSUPPORTED;
+#endif
     return st;
 }
 
@@ -273,6 +289,8 @@ static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *c
     if (work_size < cyl_observe_work_size(seg, p)) return CYL_ERR_NOMEM;
     if (p->model != CYL_GEOM_EXACT && p->model != CYL_GEOM_PAPER) return CYL_ERR_ARG;
     if (!(p->min_var_px2 >= 0.0)) return CYL_ERR_ARG;
+    if ((p->estimator == CYL_NOISE_IMAGE && !CYL_CONFIG_IMAGE_ESTIMATOR) || (p->subpixel && !CYL_CONFIG_SUBPIXEL))
+        return CYL_ERR_UNSUPPORTED;   /* compiled out (cyl/config.h) */
     if ((p->estimator == CYL_NOISE_IMAGE || p->subpixel) && (!p->image || !p->table)) return CYL_ERR_ARG;
     if (p->subpixel && (p->subpixel_params.reach < 2u || p->subpixel_params.reach > CYL_SUBPIXEL_MAX_REACH ||
                         !(p->subpixel_params.min_contrast >= 0.0) || !isfinite(p->subpixel_params.min_contrast)))
@@ -284,6 +302,7 @@ static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *c
     return CYL_OK;
 }
 
+#if CYL_CONFIG_MODELS
 cyl_status cyl_observe_groups(const cyl_segmentation *seg, const cyl_group *groups, uint32_t n_groups,
                               const cyl_landmark_model *models, uint32_t n_models, double plane_height_m,
                               const cyl_camera *cam, const cyl_observe_params *p, void *work, size_t work_size,
@@ -390,6 +409,18 @@ cyl_status cyl_observe_groups(const cyl_segmentation *seg, const cyl_group *grou
     *n_out = n;
     return ret;
 }
+#else /* CYL_CONFIG_MODELS */
+cyl_status cyl_observe_groups(const cyl_segmentation *seg, const cyl_group *groups, uint32_t n_groups,
+                              const cyl_landmark_model *models, uint32_t n_models, double plane_height_m,
+                              const cyl_camera *cam, const cyl_observe_params *p, void *work, size_t work_size,
+                              cyl_observation *out, uint32_t cap, uint32_t *n_out)
+{
+    (void)seg; (void)groups; (void)n_groups; (void)models; (void)n_models; (void)plane_height_m; (void)cam;
+    (void)p; (void)work; (void)work_size; (void)out; (void)cap;
+    if (n_out) *n_out = 0;
+    return CYL_ERR_UNSUPPORTED;
+}
+#endif
 
 cyl_status cyl_observation_budget(const cyl_observation *obs, const cyl_camera *cam,
                                   cyl_geom_model model, cyl_error_budget *b)

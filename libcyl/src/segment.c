@@ -15,6 +15,7 @@
  *   parent index is <= its own and a component's root is its first run in
  *   (y, x) order; labels therefore come out in raster order of first runs.
  */
+#include "cyl/config.h"
 #include "cyl/segment.h"
 #include "internal.h"
 #include "lowbit.h"
@@ -24,6 +25,9 @@
 #define YUV_YSTRIDE (CYL_YUV_NC * CYL_YUV_NC)
 #include <math.h>
 #include <string.h>
+
+/* a pixel format compiled in (cyl/config.h); a constant, so the other formats' code is dropped */
+#define FORMAT_ON(f) ((CYL_CONFIG_FORMATS & CYL_FORMAT_BIT(f)) != 0u)
 
 /* Per-blob accumulators (exact integer sums), in the caller's block. */
 typedef struct blob_acc {
@@ -329,16 +333,23 @@ static int encode_row(rle_ctx *ctx, const cyl_colortable *t, const cyl_image *im
     const uint8_t *r0 = img->plane[0] + (size_t)y * img->stride[0];
     if (xs == 1u) {
         uint32_t x1 = x0 + n;
+        /* a format compiled out (cyl/config.h) never gets here: cyl_image_check refuses it */
         switch (img->format) {
         case CYL_FMT_YUYV:
-            return encode_yuyv(ctx, t, y, r0, x0, x1);
+            if (FORMAT_ON(CYL_FMT_YUYV)) return encode_yuyv(ctx, t, y, r0, x0, x1);
+            break;
         case CYL_FMT_UYVY:
-            return encode_uyvy(ctx, t, y, r0, x0, x1);
+            if (FORMAT_ON(CYL_FMT_UYVY)) return encode_uyvy(ctx, t, y, r0, x0, x1);
+            break;
         case CYL_FMT_NV12:
-            return encode_nv12(ctx, t, y, r0, img->plane[1] + (size_t)(y / 2u) * img->stride[1], x0, x1);
+            if (FORMAT_ON(CYL_FMT_NV12))
+                return encode_nv12(ctx, t, y, r0, img->plane[1] + (size_t)(y / 2u) * img->stride[1], x0, x1);
+            break;
         case CYL_FMT_I420:
-            return encode_i420(ctx, t, y, r0, img->plane[1] + (size_t)(y / 2u) * img->stride[1],
-                               img->plane[2] + (size_t)(y / 2u) * img->stride[2], x0, x1);
+            if (FORMAT_ON(CYL_FMT_I420))
+                return encode_i420(ctx, t, y, r0, img->plane[1] + (size_t)(y / 2u) * img->stride[1],
+                                   img->plane[2] + (size_t)(y / 2u) * img->stride[2], x0, x1);
+            break;
         default:
             break;
         }
@@ -407,13 +418,13 @@ cyl_status cyl_classify(const cyl_colortable *t, const cyl_image *img, const cyl
         sk.fn = img->format == CYL_FMT_YUYV ? set.yuyv : img->format == CYL_FMT_UYVY ? set.uyvy
               : img->format == CYL_FMT_NV12 ? set.nv12 : set.i420;
         if (skip_rest) { skip_rest--; sk.fn = NULL; }
-        if (x_step == 1u && img->format == CYL_FMT_YUYV) {
+        if (x_step == 1u && img->format == CYL_FMT_YUYV && FORMAT_ON(CYL_FMT_YUYV)) {
             classify_pairs(t, r0, 2u, r0 + 1, r0 + 3, 4u, r.x, x1, o, &sk);
-        } else if (x_step == 1u && img->format == CYL_FMT_UYVY) {
+        } else if (x_step == 1u && img->format == CYL_FMT_UYVY && FORMAT_ON(CYL_FMT_UYVY)) {
             classify_pairs(t, r0 + 1, 2u, r0, r0 + 2, 4u, r.x, x1, o, &sk);
-        } else if (x_step == 1u && img->format == CYL_FMT_NV12) {
+        } else if (x_step == 1u && img->format == CYL_FMT_NV12 && FORMAT_ON(CYL_FMT_NV12)) {
             classify_pairs(t, r0, 1u, c1, c1 + 1, 2u, r.x, x1, o, &sk);
-        } else if (x_step == 1u && img->format == CYL_FMT_I420) {
+        } else if (x_step == 1u && img->format == CYL_FMT_I420 && FORMAT_ON(CYL_FMT_I420)) {
             classify_pairs(t, r0, 1u, c1, sk.sv, 1u, r.x, x1, o, &sk);
         } else {
             for (i = 0, x = r.x; x < x1; x += x_step, i++) {

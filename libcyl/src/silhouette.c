@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- the geometric bias of a landmark's blob centroid (cyl/silhouette.h). */
+#include "cyl/config.h"
 #include "cyl/silhouette.h"
 
 #include <math.h>
@@ -173,6 +174,7 @@ cyl_status cyl_silhouette_bias_at(const cyl_camera *cam, double x_m, double y_m,
 
 /* subject (convex, n points) clipped to the convex polygon clip (nc points): Sutherland-Hodgman,
  * the result in out (at most n + nc points), its count returned. */
+#if CYL_CONFIG_MODELS
 #define CLIP_MAX (2 * NPTS + 4)
 static int clip_convex(const double (*subject)[2], int n, const double (*clip)[2], int nc,
                        double (*out)[2], double (*tmp)[2])
@@ -266,3 +268,15 @@ cyl_status cyl_silhouette_bias_model(const cyl_camera *cam, double x_m, double y
     if (!counted || !to_normalised(&mt, x_m, y_m, 0.0, &xc, &yc)) return CYL_ERR_NO_RANGE;
     return finish(cam, m, xc, yc, rel_sigma, sigma_px, out);
 }
+
+#else /* CYL_CONFIG_MODELS */
+
+cyl_status cyl_silhouette_bias_model(const cyl_camera *cam, double x_m, double y_m,
+                                     const cyl_landmark_model *model, double base_z_m, uint32_t band_mask,
+                                     double rel_sigma, double sigma_px, cyl_silhouette_bias *out)
+{
+    (void)cam; (void)x_m; (void)y_m; (void)model; (void)base_z_m; (void)band_mask; (void)rel_sigma;
+    (void)sigma_px; (void)out;
+    return CYL_ERR_UNSUPPORTED;
+}
+#endif

@@ -12,6 +12,7 @@ const char *cyl_status_str(cyl_status s)
     case CYL_ERR_NOMEM: return "caller memory too small";
     case CYL_ERR_CLASS: return "colour class index out of range";
     case CYL_ERR_EMPTY: return "training region empty or no colour bin above threshold";
+    case CYL_ERR_UNSUPPORTED: return "feature compiled out of this build (cyl/config.h)";
     case CYL_ERR_FILE_TRUNCATED: return "table file truncated";
     case CYL_ERR_FILE_MAGIC: return "not a libcyl colour table (bad magic)";
     case CYL_ERR_FILE_VERSION: return "unsupported table file version";

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* libcyl -- a blob's centroid with its edges placed sub-pixel (cyl/subpixel.h). */
+#include "cyl/config.h"
 #include "cyl/subpixel.h"
 #include "internal.h"
 #include "lowbit.h"
@@ -16,6 +17,7 @@ cyl_subpixel_params cyl_subpixel_params_default(void)
     return p;
 }
 
+#if CYL_CONFIG_SUBPIXEL
 typedef struct sp_ctx {
     const cyl_image *img;
     const cyl_colortable *t;
@@ -209,3 +211,13 @@ cyl_status cyl_subpixel_centroid(const cyl_segmentation *seg, const cyl_blob *b,
     out->edges_moved = c.moved;
     return CYL_OK;
 }
+
+#else /* CYL_CONFIG_SUBPIXEL */
+
+cyl_status cyl_subpixel_centroid(const cyl_segmentation *seg, const cyl_blob *b, const cyl_image *img,
+                                 const cyl_colortable *t, const cyl_subpixel_params *p, cyl_subpixel_result *out)
+{
+    (void)seg; (void)b; (void)img; (void)t; (void)p; (void)out;
+    return CYL_ERR_UNSUPPORTED;
+}
+#endif

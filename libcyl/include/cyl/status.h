@@ -23,6 +23,7 @@ typedef enum cyl_status {
     CYL_ERR_NOMEM = -4,           /* caller-provided memory smaller than the sizing function asks */
     CYL_ERR_CLASS = -5,           /* colour class index out of range */
     CYL_ERR_EMPTY = -6,           /* training region empty, or no UV bin passed the threshold */
+    CYL_ERR_UNSUPPORTED = -7,     /* feature compiled out of this build (cyl/config.h) */
 
     CYL_ERR_FILE_TRUNCATED = -10, /* serialized table shorter than its format requires */
     CYL_ERR_FILE_MAGIC = -11,     /* not a libcyl colour table (magic number mismatch) */
