@@ -79,6 +79,11 @@ def predict_rb(pose, lm):
 CALIB = gtsam.symbol("c", 0)   # calibration error (fx fy cx cy tilt yaw h s): one Vector8 for the run
 
 
+def B(j):
+    """Landmark j's centroid bias (du, dv) px: a Vector2 (Params.lm_bias)."""
+    return gtsam.symbol("b", j)
+
+
 def rb_jacobians(pose, lm):
     """Predicted (bearing, range) of landmark lm from pose (x, y, theta) and their Jacobians with
     respect to the pose (GTSAM's Pose2 retraction: body-frame (vx, vy, w)) and the landmark."""
@@ -93,12 +98,18 @@ def rb_jacobians(pose, lm):
     return b, r, hp, hl
 
 
-def calib_factor(pose_key, lm_key, o, noise):
+def calib_factor(pose_key, lm_key, o, noise, bias_key=None):
     """An observation with the calibration error as a state (docs/uncertainty.md, "Constant
     calibration errors"): the frontend computed z with the nominal calibration, so
     z = h(pose, lm) - J delta + n, with delta = true - nominal calibration, J = o.jac_calib and
-    n ~ N(0, o.cov_frame). Residual in GTSAM's (bearing, range) order."""
+    n ~ N(0, o.cov_frame). Residual in GTSAM's (bearing, range) order.
+
+    With bias_key, the landmark's centroid bias b = (du, dv) px (one per landmark, see
+    Params.lm_bias) is a state too: range and bearing depend on the centroid through
+    (u - cx, v - cy), so a centroid moved by b reads as a principal-point error of b:
+    z = h - J delta - J_cxcy b + n."""
     jbr = np.vstack([o.jac_calib[1], o.jac_calib[0]])   # (bearing, range) rows
+    jpx = jbr[:, 2:4]                                   # d(bearing, range)/d(cx, cy)
 
     def error(this, values, H):
         p = values.atPose2(pose_key)
@@ -106,14 +117,19 @@ def calib_factor(pose_key, lm_key, o, noise):
         d = values.atVector(CALIB)
         b, r, hp, hl = rb_jacobians((p.x(), p.y(), p.theta()), (l[0], l[1]))
         e = np.array([b, r]) - jbr @ d - np.array([o.bearing_rad, o.range_m])
+        if bias_key is not None:
+            e = e - jpx @ values.atVector(bias_key)
         e[0] = (e[0] + np.pi) % (2 * np.pi) - np.pi
         if H is not None:
             H[0] = hp
             H[1] = hl
             H[2] = -jbr
+            if bias_key is not None:
+                H[3] = -jpx
         return e
 
-    return gtsam.CustomFactor(noise, [pose_key, lm_key, CALIB], error)
+    keys = [pose_key, lm_key, CALIB] + ([bias_key] if bias_key is not None else [])
+    return gtsam.CustomFactor(noise, keys, error)
 
 
 def calib_prior(cov):
@@ -158,6 +174,12 @@ class Params:
     batch: bool = True             # final batch Levenberg-Marquardt
     covariances: bool = True       # compute marginals after the batch pass
     calib_states: bool = False     # estimate the calibration error (constant over the run) as a state
+    lm_bias: str = "auto"          # with calib_states, the centroid's residual bias (obs.bias_var_px2):
+                                   # state (one (du, dv) px state per landmark shared by all its
+                                   # observations, prior from the log's bias_var_px2 of the
+                                   # observation that starts it, taken out of each cov_frame) |
+                                   # none (white noise like the rest of cov_frame) | auto (state
+                                   # where the observation that starts a landmark has the field)
 
 
 @dataclass
@@ -208,6 +230,19 @@ class Slam:
             raise ValueError(f"unknown robust kernel {self.p.robust!r}")
         return g
 
+    def _bias_prior(self, o, use_calib):
+        """The prior variance (u, v) px^2 of a new landmark's centroid-bias state, or None for no
+        state (Params.lm_bias): the variance the frontend gives the bias of the observation that
+        starts the landmark."""
+        p = self.p
+        if not use_calib or p.lm_bias == "none":
+            return None
+        if o.bias_var_px2 is None:
+            if p.lm_bias == "state":
+                raise ValueError(f"{o.where}: --lm-bias state needs the observation's bias_var_px2")
+            return None
+        return np.maximum(o.bias_var_px2, 1e-12)
+
     def run(self, ds) -> Result:
         p = self.p
         t0 = time.perf_counter()
@@ -245,6 +280,9 @@ class Slam:
             graph.add(f)
             new_f.add(f)
             new_v.insert(CALIB, np.zeros(8))
+        if p.lm_bias not in ("auto", "none", "state"):
+            raise ValueError(f"unknown landmark bias model {p.lm_bias!r}")
+        lm_bias = {}                        # landmark -> its bias state's prior variance (u, v) px^2, or None
         cur = start.copy()                  # current estimate of the newest pose
         lms_init = []                       # initial/latest estimate per landmark
         lm_class, lm_ids = [], []
@@ -253,7 +291,7 @@ class Slam:
         assoc = []
         st = dict(obs_total=0, dropped_flags=0, dropped_no_range=0, dropped_confidence=0, dropped_far=0,
                   dropped_ambiguous=0, dropped_imprecise=0, used=0, new_landmarks=0, isam_updates=0,
-                  marginal_calls=0, association=mode, by_identity=0)
+                  marginal_calls=0, association=mode, by_identity=0, bias_states=0)
         last_update = 0
         gate = chi2_2dof(p.gate_p)
         new_thr = chi2_2dof(p.new_p)
@@ -327,11 +365,25 @@ class Slam:
                     if o.lm_id is not None and mode in ("known", "mixed"):
                         id_to_lm[o.lm_id] = j
                     new_v.insert(L(j), gtsam.Point2(*pos))
+                    var = self._bias_prior(o, use_calib)
+                    lm_bias[j] = var
+                    if var is not None:
+                        new_v.insert(B(j), np.zeros(2))
+                        f = gtsam.PriorFactorVector(B(j), np.zeros(2), gtsam.noiseModel.Diagonal.Variances(var))
+                        graph.add(f)
+                        new_f.add(f)
+                        st["bias_states"] += 1
                     st["new_landmarks"] += 1
                 if use_calib:
                     if o.jac_calib is None:
                         raise ValueError(f"{o.where}: calibration states need jac_calib and cov_frame")
-                    f = calib_factor(X(i), L(j), o, self._obs_noise(o.cov_frame))
+                    cf = o.cov_frame
+                    if lm_bias[j] is not None and o.bias_var_px2 is not None:
+                        # the bias is the landmark's state now, not noise of this frame: as much of
+                        # it as the state's prior covers
+                        jpx = o.jac_calib[:, 2:4]
+                        cf = cf - jpx @ np.diag(np.minimum(o.bias_var_px2, lm_bias[j])) @ jpx.T
+                    f = calib_factor(X(i), L(j), o, self._obs_noise(cf), B(j) if lm_bias[j] is not None else None)
                 else:
                     f = gtsam.BearingRangeFactor2D(X(i), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
                                                    self._obs_noise(c))

@@ -51,6 +51,7 @@ def _params(args, **over):
                cand_radius=args.cand_radius, init_max_sigma=args.init_max_sigma, robust=args.robust, huber_k=args.huber_k,
                anchor=args.anchor, batch=not args.no_batch, reject_flags=int(args.reject_flags, 0),
                calib_states=getattr(args, "calib_states", False),
+               lm_bias=getattr(args, "lm_bias", "auto"),
                max_range_rel_sigma=(None if getattr(args, "max_range_rel_sigma", None) in (None, 0)
                                     else args.max_range_rel_sigma))
     for k, v in over.items():
@@ -332,6 +333,11 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
                         "state for the run: each observation's factor uses its frame covariance and "
                         "calibration Jacobian instead of its full covariance (our logs; "
                         "docs/uncertainty.md)")
+    g.add_argument("--lm-bias", choices=["auto", "state", "none"], default="auto",
+                   help="with --calib-states: the centroid's residual bias (the log's bias_var_px2) "
+                        "as one state per landmark shared by its observations (state), or as white "
+                        "noise in each frame like the rest of cov_frame (none); auto: state where "
+                        "the log has the field (default %(default)s)")
     g.add_argument("--fixed-cov", choices=["grid", "mean", "none"], default=fixed_default,
                    help="side-by-side run with ONE fixed observation covariance: the mean of the "
                         "per-observation covariances (mean), or the best of 0.25..4 x that mean by "

@@ -35,6 +35,8 @@ class Obs:
     where: str = ""               # "file:line" for messages
     jac_calib: Optional[np.ndarray] = None   # 2x8 d(range, bearing)/d(fx fy cx cy tilt yaw h s), or None
     cov_frame: Optional[np.ndarray] = None   # 2x2 frame-to-frame covariance (no calibration), or None
+    bias_var_px2: Optional[np.ndarray] = None   # (u, v) variance of the centroid's residual bias, px^2,
+                                  # a part of cov_frame that does not change from frame to frame
 
 
 @dataclass

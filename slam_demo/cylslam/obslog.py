@@ -231,15 +231,20 @@ class _Builder:
             cov = np.array([[crr, crb], [crb, cbb]])
             if not unusable:
                 _check_cov(cov, where, "range/bearing")
-            jm = cf = None
+            jm = cf = bv = None
             if not unusable and "jac_calib" in rec:   # optional (docs/formats.md)
                 jm = np.array(_numlist(rec, "jac_calib", 16, where)).reshape(2, 8)
                 c3 = _numlist(rec, "cov_frame", 3, where)
                 cf = np.array([[c3[0], c3[1]], [c3[1], c3[2]]])
                 _check_cov(cf, where, "cov_frame")
+                if "bias_var_px2" in rec:
+                    bv = np.array(_numlist(rec, "bias_var_px2", 2, where))
+                    if (bv < 0).any():
+                        raise ObsLogError(f"{where}: bias_var_px2 must be >= 0, got {bv.tolist()}")
             fr = self._frame_of(rec, where, "obs")
             fr["obs"].append(Obs(cls=cls, range_m=r, bearing_rad=b, cov=cov, confidence=conf,
-                                 flags=flags, lm_id=lm_id, where=where, jac_calib=jm, cov_frame=cf))
+                                 flags=flags, lm_id=lm_id, where=where, jac_calib=jm, cov_frame=cf,
+                                 bias_var_px2=bv))
         elif typ == "odom":
             d = np.array([_num(rec, k, where) for k in ("dx_m", "dy_m", "dtheta_rad")])
             xx, xy, xt, yy, yt, tt = _numlist(rec, "cov", 6, where, " (xx xy xt yy yt tt)")
