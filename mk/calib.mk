@@ -83,7 +83,7 @@ calib-test: $(CALIB_TEST_BINS)
 TEST_EXTRA += $(STAMP)/debs-calibgui $(BUILD)/cyl-train
 TEST_EXTRA_BINS += tests/calib/gui_test.sh:$(BUILD)
 TEST_EXTRA += $(BUILD)/cyl-score
-calib-gui-test: $(STAMP)/debs-calibgui $(BUILD)/cyl-train
+calib-gui-test: $(STAMP)/debs-calibgui $(BUILD)/cyl-train $(BUILD)/cyl-score
 	@tests/calib/gui_test.sh $(BUILD)
 .PHONY: calib-gui-test
 

@@ -37,17 +37,23 @@ cleanup() {
 }
 trap cleanup EXIT
 
-# a free display number
-D=""
-for n in $(seq 77 120); do
-  if [ ! -e /tmp/.X11-unix/X$n ] && [ ! -e /tmp/.X$n-lock ]; then D=$n; break; fi
-done
-[ -z "$D" ] && { bad setup "no free X display number"; finish; }
-Xvfb :$D -screen 0 800x600x24 -nolisten tcp >"$W/xvfb.log" 2>&1 &
+# The X server picks a free display itself (-displayfd: no race with another server choosing the
+# same number) and does not reset when its last client disconnects (-noreset: the readiness probe
+# below is a client; a reset between it and the tool's connection refused the tool once in CI).
+Xvfb -displayfd 3 -noreset -screen 0 800x600x24 -nolisten tcp 3>"$W/display" >"$W/xvfb.log" 2>&1 &
 XPID=$!
+D=""
+for i in $(seq 100); do
+  D=$(head -1 "$W/display" 2>/dev/null)
+  [ -n "$D" ] && break
+  kill -0 "$XPID" 2>/dev/null || break
+  sleep 0.1
+done
+[ -z "$D" ] && { bad setup "Xvfb gave no display: $(cat "$W/xvfb.log")"; finish; }
 export DISPLAY=:$D
 for i in $(seq 50); do xdotool getmouselocation >/dev/null 2>&1 && break; sleep 0.1; done
 xdotool getmouselocation >/dev/null 2>&1 || { bad setup "Xvfb did not start: $(cat "$W/xvfb.log")"; finish; }
+xstate() { if kill -0 "$XPID" 2>/dev/null; then echo "X server :$D running"; else echo "X server :$D gone: $(cat "$W/xvfb.log")"; fi; }
 
 # test image: grey, an orange patch (x 40..99, y 60..159) and a green one (x 200..249, y 80..169)
 "$CONVERT" -size 320x240 xc:'rgb(120,120,120)' -fill 'rgb(240,120,20)' -draw 'rectangle 40,60 99,159' \
@@ -62,7 +68,7 @@ for i in $(seq 100); do
   [ -n "$wid" ] && grep -q "window open" "$W/tool.log" && break
   sleep 0.1
 done
-if [ -z "$wid" ]; then bad window "no cyl-train window: $(cat "$W/tool.log")"; finish; fi
+if [ -z "$wid" ]; then bad window "no cyl-train window: $(cat "$W/tool.log"); $(xstate)"; finish; fi
 ok "window opens"
 sleep 0.5
 eval "$(xdotool getwindowgeometry --shell "$wid")"   # X Y WIDTH HEIGHT of the window
@@ -150,7 +156,7 @@ for i in $(seq 100); do
   [ -n "$wid" ] && grep -q "window open" "$W/tool.log" && break
   sleep 0.1
 done
-if [ -z "$wid" ]; then bad learnwindow "no window: $(cat "$W/tool.log")"; finish; fi
+if [ -z "$wid" ]; then bad learnwindow "no window: $(cat "$W/tool.log"); $(xstate)"; finish; fi
 sleep 0.5
 eval "$(xdotool getwindowgeometry --shell "$wid")"
 xdotool windowfocus --sync "$wid" 2>/dev/null || xdotool windowfocus "$wid"
