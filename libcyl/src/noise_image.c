@@ -87,13 +87,23 @@ static int in_grid(const img_ctx *c, int32_t gx, int32_t gy)
 }
 
 /* The cell's mean colour, estimated from the frame: the average of the cell and its neighbours
- * along the edge (+-2 cells in the direction edge_direction() picks). The average still carries part of the noise (the fraction vf of the
- * noise variance: 1/5 for Y; more for chroma samples shared by neighbours), so each draw adds
- * noise of variance (1 - vf) sigma^2: the simulated values then have exactly the frame's noise.
- * (Adding sigma^2 to the noisy value itself would count the noise twice.) */
+ * along the edge (+-IMG_MEAN_HALF cells in the direction edge_direction() picks; a wider window
+ * leaves more of the noise out of the mean but follows a curved edge worse, and at low noise a
+ * mean a fraction of a level off puts the flips on the wrong cells).
+ *
+ * The draws come in pairs, a = mean + e_a and b = mean + e_b. The mean still carries the share vf
+ * of the noise variance (1/3 for Y over three cells; more for chroma samples shared by the cells),
+ * an error common to every draw of the cell. Noises with variance (1 - vf) sigma^2 each and
+ * covariance -vf sigma^2 make a and b two independent frames around the cell's true colour, each
+ * with the frame's noise sigma^2, and half the squared difference of two such frames' moments is an
+ * unbiased variance however close the true colour is to the class boundary. (Independent draws of
+ * variance (1 - vf) sigma^2 read sqrt(1 - vf) of it where edge colours lie evenly across the
+ * boundary, and less near one sharp edge.) With e = sigma (p z1 +- q z2): p^2 = (1 - 2 vf) / 2,
+ * q^2 = 1/2; vf above 1/2 (a chroma sample shared by two of the three cells) keeps p = 0. */
+#define IMG_MEAN_HALF 1
 typedef struct cell_mean {
     double y, u, v;        /* mean, levels */
-    double ky, kc;         /* noise std multipliers of the draws: sqrt(1 - vf) for Y and chroma */
+    double py, pc;         /* the draws' p (above) for Y and chroma */
     uint32_t x, yy;        /* image coordinates */
 } cell_mean;
 
@@ -133,7 +143,7 @@ static void mean_of_cell(const img_ctx *c, int32_t gx, int32_t gy, int dir, cell
      * resolution), so that cells sharing a chroma sample get the same chroma mean and flip together
      * in the draws, as they do in the frame. */
     if (c->sub_h && c->g.sx == 1u && (((uint32_t)gx * c->g.sx + c->g.rx) & 1u) && in_grid(c, gx - 1, gy)) cgx = gx - 1;
-    for (d = -2; d <= 2; d++) {
+    for (d = -IMG_MEAN_HALF; d <= IMG_MEAN_HALF; d++) {
         int32_t qx = gx + d * kDir[dir][0], qy = gy + d * kDir[dir][1];
         uint8_t Y, U, V;
         if (!in_grid(c, qx, qy)) continue;
@@ -141,7 +151,7 @@ static void mean_of_cell(const img_ctx *c, int32_t gx, int32_t gy, int dir, cell
         sy += Y;
         n++;
     }
-    for (d = -2; d <= 2; d++) {
+    for (d = -IMG_MEAN_HALF; d <= IMG_MEAN_HALF; d++) {
         int32_t qx = cgx + d * kDir[dir][0], qy = gy + d * kDir[dir][1];
         uint32_t x, y, key;
         uint8_t Y, U, V;
@@ -161,34 +171,50 @@ static void mean_of_cell(const img_ctx *c, int32_t gx, int32_t gy, int dir, cell
         grp++;
     }
     sw2 += (double)grp * (double)grp;
-    m->y = sy / n;
-    m->u = su / nc;
-    m->v = sv / nc;
-    m->ky = sqrt(1.0 - 1.0 / n);
-    m->kc = sqrt(1.0 - sw2 / ((double)nc * (double)nc));
     m->x = (uint32_t)gx * c->g.sx + c->g.rx;
     m->yy = (uint32_t)gy * c->g.sy + c->g.ry;
+    {
+        const double vfy = 1.0 / n, vfc = sw2 / ((double)nc * (double)nc);
+        m->y = sy / n;
+        m->u = su / nc;
+        m->v = sv / nc;
+        m->py = vfy < 0.5 ? sqrt(0.5 - vfy) : 0.0;
+        m->pc = vfc < 0.5 ? sqrt(0.5 - vfc) : 0.0;
+    }
 }
 
-/* Is the cell of class cls in simulated frame k? */
-static int cell_in(const img_ctx *c, const cell_mean *m, uint32_t k)
+/* Is the cell of class cls in the simulated frames 2j and 2j + 1, a pair (cell_mean): they share z1
+ * and take z2 with opposite signs? Bit 0: frame 2j, bit 1: frame 2j + 1. */
+static unsigned pair_in(const img_ctx *c, const cell_mean *m, uint32_t j)
 {
-    uint32_t chx = c->sub_h ? m->x >> 1 : m->x, chy = c->sub_v ? m->yy >> 1 : m->yy;
-    uint32_t hc = key3(chx, chy, k | 0x80000000u);
-    uint8_t cy_ = clamp_level(m->y + m->ky * c->sig[0] * gauss_of(key3(m->x, m->yy, k)));
-    uint8_t cu = clamp_level(m->u + m->kc * c->sig[1] * gauss_of(hc));
-    uint8_t cv = clamp_level(m->v + m->kc * c->sig[2] * gauss_of(mix32(hc ^ 0x5bd1e995u)));
-    return cyl_lowbit[cyl_colortable_mask(c->t, cy_, cu, cv)] == c->cls;
+    const double q = 0.70710678118654752;
+    const uint32_t chx = c->sub_h ? m->x >> 1 : m->x, chy = c->sub_v ? m->yy >> 1 : m->yy;
+    const uint32_t h1 = key3(chx, chy, j | 0x80000000u), h2 = key3(chx, chy, j | 0xC0000000u);
+    const double y1 = m->py * gauss_of(key3(m->x, m->yy, j)), y2 = q * gauss_of(key3(m->x, m->yy, j | 0x40000000u));
+    const double u1 = m->pc * gauss_of(h1), u2 = q * gauss_of(h2);
+    const double v1 = m->pc * gauss_of(mix32(h1 ^ 0x5bd1e995u)), v2 = q * gauss_of(mix32(h2 ^ 0x5bd1e995u));
+    unsigned r = 0, s;
+    for (s = 0; s < 2u; s++) {
+        const double sg = s ? -1.0 : 1.0;
+        const uint8_t cy_ = clamp_level(m->y + c->sig[0] * (y1 + sg * y2));
+        const uint8_t cu = clamp_level(m->u + c->sig[1] * (u1 + sg * u2));
+        const uint8_t cv = clamp_level(m->v + c->sig[2] * (v1 + sg * v2));
+        if (cyl_lowbit[cyl_colortable_mask(c->t, cy_, cu, cv)] == c->cls) r |= 1u << s;
+    }
+    return r;
 }
 
+
+
+/* The variance of a quantity from its values in the k simulated frames: half the mean squared
+ * difference within the pairs (an odd last frame is not used). */
 static double draw_variance(const double *v, uint32_t k)
 {
-    uint32_t i;
-    double m = 0.0, s = 0.0;
-    for (i = 0; i < k; i++) m += v[i];
-    m /= (double)k;
-    for (i = 0; i < k; i++) s += (v[i] - m) * (v[i] - m);
-    return s / (double)(k - 1u);
+    const uint32_t pairs = k >> 1;
+    uint32_t j;
+    double s = 0.0;
+    for (j = 0; j + 1u < k; j += 2u) s += 0.5 * (v[j] - v[j + 1u]) * (v[j] - v[j + 1u]);
+    return s / (double)pairs;
 }
 
 /* ---- noise from the blob's interior ---------------------------------------------------------- */
@@ -309,10 +335,13 @@ static void interior_flips(img_ctx *c, uint32_t first)
             int32_t g0 = group == 2 ? (int32_t)(((uint32_t)gx * c->g.sx + c->g.rx) & ~1u) - (int32_t)c->g.rx : gx;
             int q;
             for (q = 0; q < group; q++) mean_of_cell(c, g0 + q, gy, 0, &cm[q]);
-            for (k = 0; k < c->draws; k++) {
-                cnt[k] = 0.0;
-                for (q = 0; q < group; q++) cnt[k] += cell_in(c, &cm[q], k);
-            }
+            for (k = 0; k < c->draws; k++) cnt[k] = 0.0;
+            for (k = 0; k + 1u < c->draws; k += 2u)
+                for (q = 0; q < group; q++) {
+                    const unsigned pr = pair_in(c, &cm[q], k >> 1);
+                    cnt[k] += (double)(pr & 1u);
+                    cnt[k + 1u] += (double)(pr >> 1);
+                }
             acc += draw_variance(cnt, c->draws) / (double)group;
             places++;
         }
@@ -485,6 +514,7 @@ static uint32_t simulate_row(const img_ctx *c, const row_lists *L, int32_t row, 
         int32_t x;
         for (x = L->d[i].a; x <= L->d[i].b + 1; x++) {
             int certain = 0, simulated = 0;
+            unsigned pr = 0;      /* the current pair's two frames (pair_in) */
             cell_mean cm = {0.0, 0.0, 0.0, 0.0, 0.0, 0u, 0u};
             if (x <= L->d[i].b) {
                 while (ie < L->ne && L->e[ie].b < x) ie++;
@@ -496,7 +526,9 @@ static uint32_t simulate_row(const img_ctx *c, const row_lists *L, int32_t row, 
                 mean_of_cell(c, x, row, edge_direction(c, x, row), &cm);
             }
             for (k = 0; k < c->draws; k++) {
-                int in = certain || (simulated && cell_in(c, &cm, k));
+                int in;
+                if (simulated && !(k & 1u)) pr = pair_in(c, &cm, k >> 1);
+                in = certain || (simulated && ((pr >> (k & 1u)) & 1u));
                 if (in && !ds.open[k]) { ds.open[k] = 1; ds.start[k] = x; }
                 else if (!in && ds.open[k]) close_run(c, L, &ds, k, x - 1, row_in_merge, m_x, wy, mx, my);
             }

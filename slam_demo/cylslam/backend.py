@@ -168,6 +168,9 @@ class Params:
     robust: str = "none"           # none | huber | cauchy
     huber_k: float = 1.345         # the kernel's threshold k on the whitened residual (Huber or Cauchy)
     fixed_cov: Optional[np.ndarray] = None   # replaces every observation covariance (r, b order)
+    fixed_frame_cov: Optional[np.ndarray] = None  # with calib_states: replaces every observation's
+                                   # frame covariance (the centroid noise, less the bias its state
+                                   # carries), the calibration's part and the states kept (r, b order)
     anchor: str = "truth"          # truth | origin
     prior_sigmas: tuple = (1e-3, 1e-3, 1e-4)
     update_every: int = 10         # iSAM2 update at least every N steps (and every observed one)
@@ -328,7 +331,10 @@ class Slam:
                 if self.on_step:
                     self.on_step(i, s.seq, s.t, cur, [], isam, lms_init)
                 continue
-            covs = [p.fixed_cov if p.fixed_cov is not None else o.cov for o in usable]
+            covs = [p.fixed_cov if p.fixed_cov is not None else
+                    (o.cov - o.cov_frame + p.fixed_frame_cov
+                     if use_calib and p.fixed_frame_cov is not None and o.cov_frame is not None else o.cov)
+                    for o in usable]
             if mode == "known":
                 # identities are given: no gating, and a landmark first seen creates it
                 targets = [id_to_lm.get(o.lm_id, -1) for o in usable]
@@ -383,6 +389,8 @@ class Slam:
                         # it as the state's prior covers
                         jpx = o.jac_calib[:, 2:4]
                         cf = cf - jpx @ np.diag(np.minimum(o.bias_var_px2, lm_bias[j])) @ jpx.T
+                    if p.fixed_frame_cov is not None:
+                        cf = p.fixed_frame_cov
                     f = calib_factor(X(i), L(j), o, self._obs_noise(cf), B(j) if lm_bias[j] is not None else None)
                 else:
                     f = gtsam.BearingRangeFactor2D(X(i), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,

@@ -86,6 +86,16 @@ def mean_obs_cov(res):
     return np.mean([o.cov for (_, o, _) in res.assoc], axis=0)
 
 
+def mean_frame_cov(res, p):
+    """The mean of the frame covariances the main run's factors used (less the part a landmark's
+    bias state carries), or None when it had no calibration states."""
+    if not p.calib_states or any(o.cov_frame is None for (_, o, _) in res.assoc):
+        return None
+    return np.mean([o.cov_frame - (o.jac_calib[:, 2:4] @ np.diag(o.bias_var_px2) @ o.jac_calib[:, 2:4].T
+                                   if o.bias_var_px2 is not None and p.lm_bias != "none" else 0.0)
+                    for (_, o, _) in res.assoc], axis=0)
+
+
 def process(ds, args, label, outdir):
     """Main run + fixed-covariance run + metrics + outputs. Returns the summary dict."""
     from . import metrics
@@ -115,13 +125,22 @@ def process(ds, args, label, outdir):
     res_fixed = None
     align_fixed = None
     if args.fixed_cov != "none" and res.assoc:
-        mean = mean_obs_cov(res)
-        scales = FIXED_GRID if (args.fixed_cov == "grid" and has_truth) else (1.0,)
+        # grid/mean: the whole covariance replaced, no calibration states in the fixed runs.
+        # frame-grid: the fixed runs keep the calibration and bias states and replace each
+        # observation's frame covariance, the per-observation noise estimate, by one matrix: the
+        # comparison is then of that estimate alone.
+        mean = mean_frame_cov(res, _params(args)) if args.fixed_cov == "frame-grid" else None
+        if args.fixed_cov == "frame-grid" and mean is None:
+            raise ValueError("--fixed-cov frame-grid needs --calib-states and frame covariances in the log")
+        key_cov = "fixed_frame_cov" if mean is not None else "fixed_cov"
+        if mean is None:
+            mean = mean_obs_cov(res)
+        scales = FIXED_GRID if (args.fixed_cov in ("grid", "frame-grid") and has_truth) else (1.0,)
         best = None
         why = []
         for sc in scales:
             try:
-                rf = Slam(_params(args, fixed_cov=mean * sc, covariances=(len(scales) == 1)),
+                rf = Slam(_params(args, **{key_cov: mean * sc}, covariances=(len(scales) == 1)),
                           progress=Progress(f"{label} fixed x{sc:g}", args.progress)).run(ds)
             except RuntimeError as e:   # GTSAM: an ill-posed system (e.g. a landmark seen once)
                 why.append(f"x{sc:g}: solver failed ({str(e).splitlines()[0][:80]})")
@@ -134,17 +153,18 @@ def process(ds, args, label, outdir):
             key = mf.get("ate_m", 0.0)
             if best is None or key < best[0]:
                 best = (key, sc, rf, mf)
-        summary["fixed_cov_tuning"] = ("grid over " + ",".join(f"{s:g}" for s in scales) +
-                                       " x the mean per-observation covariance, best ATE among the "
-                                       "runs that map landmarks"
-                                       if len(scales) > 1 else "the mean per-observation covariance")
+        what = ("the mean per-observation frame covariance (calibration and bias states kept)"
+                if key_cov == "fixed_frame_cov" else "the mean per-observation covariance")
+        summary["fixed_cov_tuning"] = ("grid over " + ",".join(f"{s:g}" for s in scales) + " x " + what +
+                                       ", best ATE among the runs that map landmarks"
+                                       if len(scales) > 1 else what)
         if best is None:
             summary["fixed_cov_failed"] = (f"none of the {len(scales)} fixed covariances gave a map: "
                                            + "; ".join(why))
         else:
             _, sc, res_fixed, mf = best
             if len(scales) > 1:   # marginals for the chosen one only
-                res_fixed = Slam(_params(args, fixed_cov=mean * sc), progress=None).run(ds)
+                res_fixed = Slam(_params(args, **{key_cov: mean * sc}), progress=None).run(ds)
                 mf = metrics.evaluate(ds, res_fixed)
             align_fixed = mf.get("_align")
             summary["fixed_cov_rb"] = (mean * sc).tolist()
@@ -338,10 +358,13 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
                         "as one state per landmark shared by its observations (state), or as white "
                         "noise in each frame like the rest of cov_frame (none); auto: state where "
                         "the log has the field (default %(default)s)")
-    g.add_argument("--fixed-cov", choices=["grid", "mean", "none"], default=fixed_default,
+    g.add_argument("--fixed-cov", choices=["grid", "mean", "frame-grid", "none"], default=fixed_default,
                    help="side-by-side run with ONE fixed observation covariance: the mean of the "
                         "per-observation covariances (mean), or the best of 0.25..4 x that mean by "
-                        "ATE (grid, needs truth), or none (default %(default)s)")
+                        "ATE (grid, needs truth; these runs have no calibration states), or, with "
+                        "--calib-states, the best of 0.25..4 x the mean frame covariance in place of "
+                        "each observation's, calibration and bias states kept (frame-grid: the "
+                        "per-observation noise estimate compared alone), or none (default %(default)s)")
     o = sp.add_argument_group("output")
     o.add_argument("--out", default=None, help="output directory (CSV, JSON, PNG)")
     o.add_argument("--no-plot", action="store_true", help="do not write plot.png")
@@ -373,6 +396,9 @@ def cmd_run(args):
         return EXIT_INPUT
     for n in ds.notes:
         print(f"note: {n}")
+    if args.fixed_cov == "frame-grid" and not args.calib_states:
+        print("cylslam: error: --fixed-cov frame-grid needs --calib-states", file=sys.stderr)
+        return EXIT_USAGE
     out = args.out or os.path.join("out", "slam", "stdin" if args.log == "-" else
                                    os.path.splitext(os.path.basename(args.log))[0])
     try:   # before the run: a folder that cannot be made fails now, not after the work

@@ -115,3 +115,24 @@ def test_frontend_log_with_calibration_error():
     assert 0.1 < np.degrees(est[4]) < 0.5
     # and the map is several times better than with the full per-observation covariance
     assert _landmark_rmse(ds, states) < 0.5 * _landmark_rmse(ds, plain)
+
+
+def test_fixed_frame_covariance_keeps_the_states_and_replaces_only_the_frame_part():
+    """--fixed-cov frame-grid: with every observation's frame covariance equal to the fixed one the
+    run is the main run (same graph); with a 100x larger one the calibration states are still
+    there (the tilt error is still found) but the observations weigh less (the landmarks move)."""
+    ds = read_obslog(FIX)
+    obs = [o for s in ds.steps for o in s.obs if o.cov_frame is not None]
+    common = sorted(obs, key=lambda o: o.cov_frame[0, 0])[len(obs) // 2].cov_frame.copy()   # a typical one
+    for o in obs:   # the same frame covariance everywhere, the full one shifted by the difference
+        o.cov = o.cov - o.cov_frame + common
+        o.cov_frame = common.copy()
+    main = Slam(Params(calib_states=True, lm_bias="none", covariances=False)).run(ds)
+    same = Slam(Params(calib_states=True, lm_bias="none", covariances=False, fixed_frame_cov=common)).run(ds)
+    assert len(main.lms) == len(same.lms) > 0
+    assert np.allclose(np.array(main.lms), np.array(same.lms), atol=1e-9)
+    assert np.allclose(main.stats["calib_error_estimate"], same.stats["calib_error_estimate"], atol=1e-9)
+    wide = Slam(Params(calib_states=True, lm_bias="none", covariances=False, fixed_frame_cov=100 * common)).run(ds)
+    assert 0.05 < np.degrees(wide.stats["calib_error_estimate"][4]) < 0.6
+    moved = [np.min(np.linalg.norm(np.array(main.lms) - l, axis=1)) for l in wide.lms]
+    assert len(moved) > 0 and max(moved) > 1e-4

@@ -149,9 +149,16 @@ static void test_noise_estimate_follows_frame(void **state)
 
 /* Monte Carlo: a soft-edged disc (2 px ramp) with noise of 2, 4 and 8 levels, 300 frames each.
  * The variance of the segmented centroid over the frames against the mean of the estimate made
- * from each single frame: within 0.65 .. 1.5 (the sample variance of 300 frames alone scatters by
- * about 8%; measured 0.71 .. 1.20). Eq. 6, which does not see the noise, is outside that range at
- * two of the levels (9.6 and 4.8 in x). This disc is not the scene the estimator was tuned on. */
+ * from each single frame: within 0.65 .. 1.65 (the sample variance of 300 frames alone scatters by
+ * about 8%; measured x 1.09 .. 1.58, y 0.98 .. 1.11). Eq. 6, which does not see the noise, is
+ * outside that range at two of the levels (9.6 and 4.8 in x). This disc is not the scene the
+ * estimator was tuned on, and it is sharper than any rendered condition: its chroma crosses the
+ * class boundary at 24 levels/px against a noise of 2, so which 4:2:2 pair flips depends on a
+ * fraction of a level; the estimate (from each cell's mean over three cells along the curved edge)
+ * puts flips on other pairs than the frames do, and in x, where a pair straddles the edge, it reads
+ * high (the safe side). The upper bound was
+ * 1.5 for the estimator's earlier form, which read y 0.71 .. 0.89 and x 0.95 .. 1.20 here and
+ * 0.57 .. 1.10 on the rendered sweep (docs/uncertainty.md). */
 static void test_monte_carlo_matches_resegmentation(void **state)
 {
     static const double sig[] = {2.0, 4.0, 8.0};
@@ -191,12 +198,61 @@ static void test_monte_carlo_matches_resegmentation(void **state)
         ry = ey / n / vy;
         print_message("  sigma %.0f: measured var %.5f %.5f px^2, image/measured %.2f %.2f, local/measured %.2f %.2f\n",
                       sig[i], vx, vy, rx, ry, lx / n / vx, ly / n / vy);
-        if (!(rx > 0.65 && rx < 1.5 && ry > 0.65 && ry < 1.5)) image_outside++;
-        if (!(lx / n / vx > 0.65 && lx / n / vx < 1.5)) local_outside++;
+        if (!(rx > 0.65 && rx < 1.65 && ry > 0.65 && ry < 1.65)) image_outside++;
+        if (!(lx / n / vx > 0.65 && lx / n / vx < 1.65)) local_outside++;
         free(f.mem);
     }
     assert_int_equal(image_outside, 0);
     assert_true(local_outside >= 2);
+}
+
+/* Soft edges: the disc with a 6 and a 12 px ramp, noise 2 and 4 levels, 300 frames each. There the
+ * edge colours lie evenly across the class boundary, and the draws must give each simulated frame
+ * the frame's whole noise around the cell's true colour: draws that add (1 - vf) sigma^2 to a mean
+ * still holding vf sigma^2 of the noise read sqrt(1 - vf) of the variance (the estimator's earlier
+ * form: mean ratio 0.85 over these eight figures, 0.74 .. 0.95); paired draws are unbiased
+ * (measured 1.00, 0.86 .. 1.06). The mean over both axes and the four settings must lie within
+ * 0.9 .. 1.15 (each figure scatters by about 8%, their mean by about 3%). */
+static void test_soft_edges_are_unbiased(void **state)
+{
+    static const double ramp[] = {6.0, 12.0}, sig[] = {2.0, 4.0};
+    const int frames = 300;
+    double sum = 0.0;
+    int figures = 0;
+    size_t a, i;
+    (void)state;
+    for (a = 0; a < 2; a++)
+        for (i = 0; i < 2; i++) {
+            fixture f;
+            test_rng rng;
+            cyl_noise_image_params q;
+            double sx = 0, sy = 0, sxx = 0, syy = 0, ex = 0, ey = 0, vx, vy;
+            int k, n = 0;
+            fx_open(&f);
+            q = cyl_noise_image_params_default();
+            test_rng_seed(&rng, 2000 + 10 * a + i);
+            for (k = 0; k < frames; k++) {
+                cyl_centroid_noise o;
+                const cyl_blob *b;
+                draw(&f, 80.37, 60.21, 18, ramp[a], sig[i], &rng);
+                b = segment(&f);
+                if (!b) continue;
+                assert_int_equal(cyl_noise_blob_image(&f.seg, b, &f.img, &f.table, &q, &o), CYL_OK);
+                sx += o.cx_px; sxx += o.cx_px * o.cx_px;
+                sy += o.cy_px; syy += o.cy_px * o.cy_px;
+                ex += o.var_x_px2; ey += o.var_y_px2;
+                n++;
+            }
+            assert_true(n >= frames - 2);
+            vx = (sxx - sx * sx / n) / (n - 1);
+            vy = (syy - sy * sy / n) / (n - 1);
+            print_message("  ramp %.0f px, sigma %.0f: image/measured %.2f %.2f\n", ramp[a], sig[i], ex / n / vx, ey / n / vy);
+            sum += ex / n / vx + ey / n / vy;
+            figures += 2;
+            free(f.mem);
+        }
+    print_message("  mean %.3f\n", sum / figures);
+    assert_true(sum / figures > 0.9 && sum / figures < 1.15);
 }
 
 static void test_bad_arguments(void **state)
@@ -238,6 +294,7 @@ int main(void)
         cmocka_unit_test(test_noise_free_hard_edge_is_certain),
         cmocka_unit_test(test_noise_estimate_follows_frame),
         cmocka_unit_test(test_monte_carlo_matches_resegmentation),
+        cmocka_unit_test(test_soft_edges_are_unbiased),
         cmocka_unit_test(test_bad_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

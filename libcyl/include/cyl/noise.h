@@ -89,16 +89,20 @@ cyl_status cyl_noise_blob(const cyl_segmentation *seg, const cyl_blob *b, cyl_no
  *   1. noise: the std of Y, U and V from second differences along the blob's interior (robust:
  *      values beyond 4 robust sigmas are dropped), at most 8 places per run, so O(runs);
  *   2. edges: every grid cell within band_px cells (Chebyshev) of both a blob cell and a non-blob
- *      cell is re-classified `draws` times with the observed value plus Gaussian noise of that std
- *      (deterministic draws from a hash of the cell; chroma draws shared by the pixels that share a
- *      chroma sample), through the same colour table and class precedence as cyl_segment;
+ *      cell is re-classified `draws` times: its colour estimated as the mean of the cell and its
+ *      two neighbours along the edge (chroma interpolated at the same offsets from the cell's
+ *      chroma sample), plus Gaussian noise drawn in pairs whose two members are independent frames
+ *      of that std around the cell's colour (the noise left in the mean is cancelled within the
+ *      pair); deterministic draws from a hash of the cell, chroma draws shared by the pixels that
+ *      share a chroma sample; through the same colour table and class precedence as cyl_segment;
  *   3. per row, each draw is run-length encoded again as cyl_segment did (runs shorter than the
  *      segmentation's min_run_px dropped; a run counts if it touches the blob's runs in this or a
  *      neighbouring row, or lies within the class's merge_gap_px of the blob's box: both read from
  *      seg, which records them), giving the row's moments
  *      sum (x - m_x) and sum (y - m_y);
- *   4. VAR(m_x) = sum over rows of the draws' variance of the row moment / n^2 (rows that share
- *      chroma samples, as in 4:2:0, are summed before the variance), likewise VAR(m_y).
+ *   4. VAR(m_x) = sum over rows of the variance of the row moment / n^2 (half the mean squared
+ *      difference within the pairs of draws; rows that share chroma samples, as in 4:2:0, are
+ *      summed first), likewise VAR(m_y).
  * This is eq. 3's sum ((i - m_x)/n)^2 rho (1 - rho) with rho taken from the frame instead of the
  * shape, plus the correlations of a row's cells. Cost O(band cells x draws) = O(perimeter).
  * Interior cells farther than band_px from every edge are taken as certain. */
@@ -113,7 +117,8 @@ typedef struct cyl_noise_image_params {
     uint32_t band_px;        /* half-width of the simulated band around the edges, grid cells, 1..4
                                 (default 4: set on the tuning seed 1 of the imaging sweep,
                                 docs/uncertainty.md; no held-out seed was used) */
-    uint32_t draws;          /* simulated frames, 2..64 (default 32) */
+    uint32_t draws;          /* simulated frames, in pairs, 2..64 (default 32; an odd last one is
+                                not used) */
 } cyl_noise_image_params;
 
 /* The defaults above. */
