@@ -112,6 +112,7 @@ inline void make_table(cyl_colortable *table)
     cyl_colortable_set_class(table, 1, "green", 0, 200, 0);
     cyl_colortable_add_box(table, 0, 60, 240, 70, 90, 180, 200);
     cyl_colortable_add_box(table, 1, 60, 240, 50, 70, 60, 80);
+    cyl_colortable_refresh(table);   // as loading a table file does: the inner boxes of the run extension
 }
 
 // The benchmarks' shared set-up: nframes distinct frames, the table, and segmentation memory.

@@ -11,7 +11,10 @@ void cyl_colortable_init(cyl_colortable *t)
     memset(t->yuv, 0xFF, sizeof t->yuv);
     t->lookup = CYL_LOOKUP_UV_Y;
     memset(t->weak_of, CYL_CLASS_NONE, sizeof t->weak_of);
-    for (i = 0; i < CYL_MAX_CLASSES; i++) t->rgb[i][0] = t->rgb[i][1] = t->rgb[i][2] = 128;
+    for (i = 0; i < CYL_MAX_CLASSES; i++) {
+        t->rgb[i][0] = t->rgb[i][1] = t->rgb[i][2] = 128;
+        memset(t->inner_lo[i], 0xFF, 3);   /* empty inner boxes */
+    }
 }
 
 cyl_status cyl_colortable_set_class(cyl_colortable *t, unsigned cls, const char *name,
@@ -68,6 +71,117 @@ static void chroma_any_update(cyl_colortable *t)
             if (t->uv[u][v]) t->chroma_any[u >> 7][v >> 4] |= (uint8_t)(1u << ((u >> 4) & 7u));
 }
 
+/* ---- inner boxes (the vector run extension's fast test) --------------------- */
+
+static void inner_empty(cyl_colortable *t, unsigned c)
+{
+    memset(t->inner_lo[c], 0xFF, 3);
+    memset(t->inner_hi[c], 0, 3);
+}
+
+/* Is every colour of the box [lo, hi] ((Y, U, V), inclusive) of class c? Within each 3-D cell the
+ * box's uv and y entries are combined through their AND (for c's bit: every colour has it) and
+ * their OR (for the lower classes' bits: no colour can have one), so the answer may be no for a
+ * box whose colours are all of class c, never yes for one that holds another colour. */
+static int inner_ok(const cyl_colortable *t, unsigned c, const unsigned lo[3], const unsigned hi[3])
+{
+    const cyl_mask bit = (cyl_mask)(1u << c), lower = (cyl_mask)(bit - 1u);
+    cyl_mask yor[CYL_YUV_NY];
+    unsigned Y, uc, vc, yc;
+    memset(yor, 0, sizeof yor);
+    for (Y = lo[0]; Y <= hi[0]; Y++) {
+        if (!(t->y[Y] & bit)) return 0;
+        yor[Y >> CYL_YUV_YSHIFT] |= t->y[Y];
+    }
+    for (uc = lo[1] >> CYL_YUV_CSHIFT; uc <= hi[1] >> CYL_YUV_CSHIFT; uc++)
+        for (vc = lo[2] >> CYL_YUV_CSHIFT; vc <= hi[2] >> CYL_YUV_CSHIFT; vc++) {
+            const unsigned u0 = uc << CYL_YUV_CSHIFT, v0 = vc << CYL_YUV_CSHIFT;
+            const unsigned ua = u0 > lo[1] ? u0 : lo[1], ub = u0 + 3u < hi[1] ? u0 + 3u : hi[1];
+            const unsigned va = v0 > lo[2] ? v0 : lo[2], vb = v0 + 3u < hi[2] ? v0 + 3u : hi[2];
+            cyl_mask any = 0;
+            unsigned U, V;
+            for (U = ua; U <= ub; U++)
+                for (V = va; V <= vb; V++) {
+                    if (!(t->uv[U][V] & bit)) return 0;
+                    any |= t->uv[U][V];
+                }
+            for (yc = lo[0] >> CYL_YUV_YSHIFT; yc <= hi[0] >> CYL_YUV_YSHIFT; yc++) {
+                const cyl_mask cell = t->yuv[yc][uc][vc];
+                if (!(cell & bit) || (any & yor[yc] & cell & lower)) return 0;
+            }
+        }
+    return 1;
+}
+
+/* Grow class c's inner box from the colour seed: the six faces in turn, each by the largest step
+ * among 16, 8, 4, 2, 1 levels that keeps the box inside the class, until none can move. */
+static void inner_grow(cyl_colortable *t, unsigned c, const unsigned seed[3])
+{
+    unsigned lo[3], hi[3], step[6], k, open = 0x3Fu;
+    for (k = 0; k < 3; k++) lo[k] = hi[k] = seed[k];
+    inner_empty(t, c);
+    if (!inner_ok(t, c, lo, hi)) return;
+    for (k = 0; k < 6; k++) step[k] = 16u;
+    while (open) {
+        for (k = 0; k < 6; k++) {
+            const unsigned a = k >> 1;
+            if (!(open & (1u << k))) continue;
+            for (;;) {
+                const unsigned room = (k & 1u) ? 255u - hi[a] : lo[a];
+                const unsigned s = step[k] < room ? step[k] : room;
+                if (s == 0) { open &= ~(1u << k); break; }
+                if (k & 1u) hi[a] += s; else lo[a] -= s;
+                if (inner_ok(t, c, lo, hi)) break;   /* moved: the next face */
+                if (k & 1u) hi[a] -= s; else lo[a] += s;
+                if (s == 1u) { open &= ~(1u << k); break; }
+                step[k] = s / 2u;
+            }
+        }
+    }
+    for (k = 0; k < 3; k++) {
+        t->inner_lo[c][k] = (uint8_t)lo[k];
+        t->inner_hi[c][k] = (uint8_t)hi[k];
+    }
+}
+
+/* Every live class's inner box, grown from the centre of its cell nearest to the mean of its
+ * cells (cells whose centre colour has the class). */
+static void inner_update(cyl_colortable *t)
+{
+    uint32_t sum[CYL_MAX_CLASSES][3], n[CYL_MAX_CLASSES], best[CYL_MAX_CLASSES];
+    unsigned seed[CYL_MAX_CLASSES][3], c, yc, uc, vc, pass;
+    memset(sum, 0, sizeof sum);
+    memset(n, 0, sizeof n);
+    for (c = 0; c < CYL_MAX_CLASSES; c++) { inner_empty(t, c); best[c] = 0xFFFFFFFFu; }
+    for (pass = 0; pass < 2u; pass++)
+        for (yc = 0; yc < CYL_YUV_NY; yc++)
+            for (uc = 0; uc < CYL_YUV_NC; uc++)
+                for (vc = 0; vc < CYL_YUV_NC; vc++) {
+                    const unsigned p[3] = { (yc << CYL_YUV_YSHIFT) + 4u, (uc << CYL_YUV_CSHIFT) + 2u,
+                                            (vc << CYL_YUV_CSHIFT) + 2u };
+                    const unsigned k = cyl_mask_class(cyl_colortable_mask(t, (uint8_t)p[0], (uint8_t)p[1],
+                                                                          (uint8_t)p[2]));
+                    unsigned a;
+                    uint32_t d = 0;
+                    if (k >= CYL_MAX_CLASSES) continue;
+                    if (pass == 0) {
+                        for (a = 0; a < 3u; a++) sum[k][a] += p[a];
+                        n[k]++;
+                        continue;
+                    }
+                    for (a = 0; a < 3u; a++) {   /* squared distance to the mean, in levels */
+                        const int32_t e = (int32_t)p[a] - (int32_t)(sum[k][a] / n[k]);
+                        d += (uint32_t)(e * e);
+                    }
+                    if (d < best[k]) {
+                        best[k] = d;
+                        for (a = 0; a < 3u; a++) seed[k][a] = p[a];
+                    }
+                }
+    for (c = 0; c < CYL_MAX_CLASSES; c++)
+        if (n[c]) inner_grow(t, c, seed[c]);
+}
+
 cyl_status cyl_colortable_clear_class(cyl_colortable *t, unsigned cls)
 {
     unsigned i, j;
@@ -86,6 +200,7 @@ cyl_status cyl_colortable_clear_class(cyl_colortable *t, unsigned cls)
     t->lookup |= CYL_LOOKUP_UV_Y;   /* the class is now held off by uv and y alone */
     t->live &= keep;
     chroma_any_update(t);
+    inner_empty(t, cls);   /* the other classes' boxes hold: no colour of theirs had this class's bit */
     return CYL_OK;
 }
 
@@ -124,6 +239,7 @@ void cyl_colortable_refresh(cyl_colortable *t)
     }
     t->live = live;
     chroma_any_update(t);
+    inner_update(t);
     t->lookup = (uint8_t)((need_uvy || !need_yuv ? CYL_LOOKUP_UV_Y : 0u) | (need_yuv ? CYL_LOOKUP_YUV : 0u));
 }
 
@@ -157,6 +273,7 @@ cyl_status cyl_colortable_add_box(cyl_colortable *t, unsigned cls,
             t->chroma_any[u >> 3][v] |= (uint8_t)(1u << (u & 7u));
     t->lookup |= CYL_LOOKUP_UV_Y;   /* a box class is limited by uv and y */
     t->live |= bit;
+    for (u = cls + 1u; u < CYL_MAX_CLASSES; u++) inner_empty(t, u);   /* colours of theirs may now be cls */
     return CYL_OK;
 }
 

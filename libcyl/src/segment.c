@@ -192,8 +192,13 @@ CYL_HOT_INLINE uint32_t skip_background(const cyl_colortable *t, const uint8_t *
             const uint32_t xs0 = x;
             x = 2u * sk->fn(sk->su, sk->sv, t->chroma_any, x / 2u, x1 / 2u);
             if (x + 16u < x1) xlim = x + 16u;
-            if (x - xs0 < 32u && --sk->misses == 0) { sk->fn = NULL; *sk->rest_rows = 7u; }
             pu = up + (x / 2u) * cs; pv = vp + (x / 2u) * cs;
+            /* a miss: a short skip that stopped at a pair of no class (the coarse map's false alarm;
+             * stopping at a coloured pair is the skip doing its work) */
+            if (x - xs0 < 32u && (x + 1u >= x1 || uv[pu[0]][pv[0]] == 0) && --sk->misses == 0) {
+                sk->fn = NULL;
+                *sk->rest_rows = 7u;
+            }
         }
     }
     while (x + 3u < xlim && (uv[pu[0]][pv[0]] | uv[pu[cs]][pv[cs]]) == 0) {
@@ -361,12 +366,16 @@ static int encode_row(rle_ctx *ctx, const cyl_colortable *t, const cyl_image *im
 
 /* Class indices of samples [x0, x1) of a row of a 4:2:x format (layout as encode_pairs), into
  * o[0, x1 - x0): a chroma pair that maps to no class is written as background without reading
- * luma, and stretches of such pairs are found by skip_background, as in the segmentation. */
+ * luma, and stretches of such pairs are found by skip_background, as in the segmentation; a class
+ * that has held for two pairs is extended by the run extension (ext: NULL for none; sy, su, sv its
+ * row pointers), which stops being tried in a row where it keeps stopping early, as there. */
 CYL_HOT_INLINE void classify_pairs(const cyl_colortable *t, const uint8_t *yp, const unsigned ysz,
                                    const uint8_t *up, const uint8_t *vp, const unsigned cs, uint32_t x0,
-                                   uint32_t x1, uint8_t *o, bg_skip *sk)
+                                   uint32_t x1, uint8_t *o, bg_skip *sk, cyl_extend_fn ext,
+                                   const uint8_t *sy, const uint8_t *su, const uint8_t *sv)
 {
     uint32_t x = x0;
+    unsigned prev = CYL_CLASS_NONE, ext_misses = 16u;
 #define PIX_CLASS(X) cyl_lowbit[cyl_colortable_mask(t, yp[(X) * ysz], up[((X) / 2u) * cs], vp[((X) / 2u) * cs])]
     if (x & 1u) { o[0] = PIX_CLASS(x); x++; }
     while (x + 1u < x1) {
@@ -376,15 +385,28 @@ CYL_HOT_INLINE void classify_pairs(const cyl_colortable *t, const uint8_t *yp, c
             const uint32_t xn = skip_background(t, up, vp, cs, x + 2u, x1, sk);
             memset(o + (x - x0), CYL_CLASS_NONE, xn - x);
             x = xn;
+            prev = CYL_CLASS_NONE;
             continue;
         }
         {
             const cyl_mask *col = &t->yuv[0][U >> CYL_YUV_CSHIFT][V >> CYL_YUV_CSHIFT];
             const uint8_t Y0 = yp[x * ysz], Y1 = yp[(x + 1u) * ysz];
-            o[x - x0] = cyl_lowbit[m & t->y[Y0] & col[(unsigned)(Y0 >> CYL_YUV_YSHIFT) * YUV_YSTRIDE]];
-            o[x + 1u - x0] = cyl_lowbit[m & t->y[Y1] & col[(unsigned)(Y1 >> CYL_YUV_YSHIFT) * YUV_YSTRIDE]];
+            const uint8_t c0 = cyl_lowbit[m & t->y[Y0] & col[(unsigned)(Y0 >> CYL_YUV_YSHIFT) * YUV_YSTRIDE]];
+            const uint8_t c1 = cyl_lowbit[m & t->y[Y1] & col[(unsigned)(Y1 >> CYL_YUV_YSHIFT) * YUV_YSTRIDE]];
+            o[x - x0] = c0;
+            o[x + 1u - x0] = c1;
+            x += 2u;
+            if (c0 != c1 || c0 == CYL_CLASS_NONE) { prev = CYL_CLASS_NONE; continue; }
+            if (ext && prev == c0 && x + 1u < x1) {   /* the class has held for two pairs: extend it */
+                const uint32_t xe = 2u * ext(t, sy, su, sv, x / 2u, x1 / 2u, c0);
+                memset(o + (x - x0), c0, xe - x);
+                if (xe - x < 16u && --ext_misses == 0) ext = NULL;
+                x = xe;
+                prev = CYL_CLASS_NONE;   /* the pair at x decides afresh */
+                continue;
+            }
+            prev = c0;
         }
-        x += 2u;
     }
     if (x < x1) o[x - x0] = PIX_CLASS(x);
 #undef PIX_CLASS
@@ -419,13 +441,13 @@ cyl_status cyl_classify(const cyl_colortable *t, const cyl_image *img, const cyl
               : img->format == CYL_FMT_NV12 ? set.nv12 : set.i420;
         if (skip_rest) { skip_rest--; sk.fn = NULL; }
         if (x_step == 1u && img->format == CYL_FMT_YUYV && FORMAT_ON(CYL_FMT_YUYV)) {
-            classify_pairs(t, r0, 2u, r0 + 1, r0 + 3, 4u, r.x, x1, o, &sk);
+            classify_pairs(t, r0, 2u, r0 + 1, r0 + 3, 4u, r.x, x1, o, &sk, set.ext_yuyv, r0, r0, NULL);
         } else if (x_step == 1u && img->format == CYL_FMT_UYVY && FORMAT_ON(CYL_FMT_UYVY)) {
-            classify_pairs(t, r0 + 1, 2u, r0, r0 + 2, 4u, r.x, x1, o, &sk);
+            classify_pairs(t, r0 + 1, 2u, r0, r0 + 2, 4u, r.x, x1, o, &sk, set.ext_uyvy, r0, r0, NULL);
         } else if (x_step == 1u && img->format == CYL_FMT_NV12 && FORMAT_ON(CYL_FMT_NV12)) {
-            classify_pairs(t, r0, 1u, c1, c1 + 1, 2u, r.x, x1, o, &sk);
+            classify_pairs(t, r0, 1u, c1, c1 + 1, 2u, r.x, x1, o, &sk, set.ext_nv12, r0, c1, NULL);
         } else if (x_step == 1u && img->format == CYL_FMT_I420 && FORMAT_ON(CYL_FMT_I420)) {
-            classify_pairs(t, r0, 1u, c1, sk.sv, 1u, r.x, x1, o, &sk);
+            classify_pairs(t, r0, 1u, c1, sk.sv, 1u, r.x, x1, o, &sk, set.ext_i420, r0, c1, sk.sv);
         } else {
             for (i = 0, x = r.x; x < x1; x += x_step, i++) {
                 uint8_t Y, U, V;

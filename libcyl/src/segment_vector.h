@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
-/* The vector background skip of cyl_segment() (internal, included by segment.c only).
+/* The vector background skip and run extension of cyl_segment() (internal, included by segment.c
+ * only).
  *
  * Where no run is open, the scalar path reads each chroma pair's uv entry to find the
  * next pixel that may be coloured. The vector path does the same test 16 chroma pairs
@@ -22,6 +23,11 @@
  * (block bit set) among the whole blocks of 16 pairs it examined; when fewer than 16
  * pairs are left it stops and returns the first pair it did not examine. It reads only
  * the chroma bytes of pairs [p, q] rounded up to its block: no byte past pair n - 1.
+ *
+ * Inside a run the vector path tests whole blocks of pairs against the run's class's inner box
+ * (cyl_colortable.inner_lo / inner_hi, computed by cyl_colortable_refresh(): colours that are
+ * certainly of that class) with byte compares, and hands the first pair outside the box to an exact
+ * test. As with the skip, the box can only say "certainly", so the runs are the scalar path's.
  */
 #ifndef CYL_SEGMENT_VECTOR_H
 #define CYL_SEGMENT_VECTOR_H
@@ -34,9 +40,11 @@
 typedef uint32_t (*cyl_skip_fn)(const uint8_t *u, const uint8_t *v, const uint8_t (*map)[16],
                                 uint32_t p, uint32_t n);
 
-/* Run extension (AVX2 only: it needs gathers): with a run of class cur open at pair p, the first
- * pair index q in [p, n) at which some pixel is not of class cur, examining 8 pairs (16 pixels)
- * at a time; when fewer than 8 pairs are left it returns the first pair it did not examine.
+/* Run extension: with a run of class cur open at pair p, a pair index q in [p, n) such that every
+ * pixel of pairs [p, q) is of class cur, found a block of 8 (x86) or 16 (NEON) pairs at a time with
+ * the class's inner box. AVX2 returns the first pair of another class (it decides the pairs outside
+ * the box exactly, by gathers); SSE and NEON return the first pair outside the box, which the scalar
+ * path decides. When less than a block is left it returns the first pair it did not examine.
  * y: the luma row (packed formats: the row), u, v: as for cyl_skip_fn. */
 typedef uint32_t (*cyl_extend_fn)(const cyl_colortable *t, const uint8_t *y, const uint8_t *u,
                                   const uint8_t *v, uint32_t p, uint32_t n, unsigned cur);
@@ -224,6 +232,65 @@ CYL_SKIP_TARGET_AVX2 static uint32_t cyl_skip_i420_avx2(const uint8_t *u, const 
     return cyl_skip_i420_ssse3(u, v, map, p, n);
 }
 
+/* A packed pair's 4 box bytes (corner c: Y, U, V) with Y0, Y1, U, V at byte offsets oy0, oy1, ou, ov. */
+static inline uint32_t cyl_box_word(const uint8_t *c, unsigned oy0, unsigned oy1, unsigned ou, unsigned ov)
+{
+    return (uint32_t)c[0] << (8u * oy0) | (uint32_t)c[0] << (8u * oy1) | (uint32_t)c[1] << (8u * ou) |
+           (uint32_t)c[2] << (8u * ov);
+}
+
+/* The run extension's box test (cyl_colortable.inner_lo / inner_hi: colours that are certainly of
+ * class cur), 8 pairs at a time with byte compares in 128-bit registers: the first pair with a byte
+ * outside the box, or the first pair not examined when less than 8 are left; p itself when the
+ * box is empty. This is the whole extension where there are no gathers (SSSE3): the scalar path
+ * decides the pair it stops at and, where the run goes on, extends again. */
+#define CYL_IN128(w, l, h) (unsigned)_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_min_epu8(_mm_max_epu8(w, l), h), w))
+/* packed formats: a pair's 4 bytes hold Y0, Y1, U, V at offsets OY0, OY1, OU, OV; MASK8(b, bl, bh)
+ * is one bit a byte for the 32 bytes at b (8 pairs), set where the byte lies in the box */
+#define CYL_BOX_PACKED(NAME, TARGET, VEC, SET1, MASK8, OY0, OY1, OU, OV)                        \
+    TARGET static uint32_t NAME(const cyl_colortable *t, const uint8_t *y, const uint8_t *u,   \
+                                const uint8_t *v, uint32_t p, uint32_t n, unsigned cur)        \
+    {                                                                                          \
+        const VEC bl = SET1((int)cyl_box_word(t->inner_lo[cur], OY0, OY1, OU, OV));            \
+        const VEC bh = SET1((int)cyl_box_word(t->inner_hi[cur], OY0, OY1, OU, OV));            \
+        (void)u; (void)v;                                                                      \
+        if (t->inner_lo[cur][0] > t->inner_hi[cur][0]) return p;   /* no box */                \
+        for (; p + 8u <= n; p += 8u) {                                                         \
+            const unsigned m = MASK8(y + 4u * (size_t)p, bl, bh);                              \
+            if (m != 0xFFFFFFFFu) return p + (uint32_t)__builtin_ctz(~m) / 4u;                 \
+        }                                                                                      \
+        return p;                                                                              \
+    }
+#define CYL_MASK8_SSE(b, bl, bh) \
+    (CYL_IN128(_mm_loadu_si128((const __m128i *)(const void *)(b)), bl, bh) | \
+     CYL_IN128(_mm_loadu_si128((const __m128i *)(const void *)((b) + 16)), bl, bh) << 16)
+CYL_BOX_PACKED(cyl_extend_yuyv_sse, CYL_SKIP_TARGET, __m128i, _mm_set1_epi32, CYL_MASK8_SSE, 0, 2, 1, 3)
+CYL_BOX_PACKED(cyl_extend_uyvy_sse, CYL_SKIP_TARGET, __m128i, _mm_set1_epi32, CYL_MASK8_SSE, 1, 3, 0, 2)
+#undef CYL_MASK8_SSE
+/* planar: 16 luma bytes and 8 (U, V) byte pairs (NV12's chroma row as it is, I420's two interleaved) */
+#define CYL_EXTEND_PLANAR_SSE(NAME, CHROMA)                                                     \
+    CYL_SKIP_TARGET static uint32_t NAME(const cyl_colortable *t, const uint8_t *y,            \
+                                         const uint8_t *u, const uint8_t *v, uint32_t p,       \
+                                         uint32_t n, unsigned cur)                             \
+    {                                                                                          \
+        const uint8_t *lo = t->inner_lo[cur], *hi = t->inner_hi[cur];                          \
+        const __m128i yl = _mm_set1_epi8((char)lo[0]), yh = _mm_set1_epi8((char)hi[0]);        \
+        const __m128i cl = _mm_set1_epi16((short)(lo[1] | lo[2] << 8)), ch = _mm_set1_epi16((short)(hi[1] | hi[2] << 8)); \
+        (void)v;                                                                               \
+        if (lo[0] > hi[0]) return p;                                                           \
+        for (; p + 8u <= n; p += 8u) {                                                         \
+            const __m128i lb = _mm_loadu_si128((const __m128i *)(const void *)(y + 2u * (size_t)p)); \
+            const unsigned m = CYL_IN128(lb, yl, yh) & CYL_IN128(CHROMA, cl, ch);              \
+            if (m != 0xFFFFu) return p + (uint32_t)__builtin_ctz(~m) / 2u;                     \
+        }                                                                                      \
+        return p;                                                                              \
+    }
+CYL_EXTEND_PLANAR_SSE(cyl_extend_nv12_sse, _mm_loadu_si128((const __m128i *)(const void *)(u + 2u * (size_t)p)))
+CYL_EXTEND_PLANAR_SSE(cyl_extend_i420_sse, _mm_unpacklo_epi8(_mm_loadl_epi64((const __m128i *)(const void *)(u + p)),
+                                                             _mm_loadl_epi64((const __m128i *)(const void *)(v + p))))
+#undef CYL_EXTEND_PLANAR_SSE
+#undef CYL_IN128
+
 /* Class masks of 16 pixels (even pixels Y0, odd Y1; chroma U, V per pair; 32-bit lanes) by the
  * table's rule (cyl_colortable_mask, with t->lookup's parts), compared with class cur: bit i of
  * the result set when pair i has a pixel of another class. The gathers read 4 bytes from each
@@ -258,7 +325,9 @@ CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_run_breaks(const cyl_colortable 
     return ~ok & 0xFFu;
 }
 
-#define CYL_EXTEND_AVX2(NAME, LOAD)                                                            \
+/* The exact test of a run by gathers, 8 pairs at a time: the first pair with a pixel of another
+ * class, or the first pair not examined when less than 8 are left. */
+#define CYL_GATHER_AVX2(NAME, LOAD)                                                            \
     CYL_SKIP_TARGET_AVX2 static uint32_t NAME(const cyl_colortable *t, const uint8_t *y,       \
                                               const uint8_t *u, const uint8_t *v, uint32_t p,  \
                                               uint32_t n, unsigned cur)                        \
@@ -276,26 +345,66 @@ CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_run_breaks(const cyl_colortable 
         return p;                                                                              \
     }
 /* packed: each 32-bit lane is one pair's 4 bytes */
-CYL_EXTEND_AVX2(cyl_extend_yuyv_avx2, {
+CYL_GATHER_AVX2(cyl_gather_yuyv_avx2, {
     const __m256i w = _mm256_loadu_si256((const __m256i *)(const void *)(y + 4u * (size_t)p));
     Y0 = _mm256_and_si256(w, ff); U = _mm256_and_si256(_mm256_srli_epi32(w, 8), ff);
     Y1 = _mm256_and_si256(_mm256_srli_epi32(w, 16), ff); V = _mm256_srli_epi32(w, 24); })
-CYL_EXTEND_AVX2(cyl_extend_uyvy_avx2, {
+CYL_GATHER_AVX2(cyl_gather_uyvy_avx2, {
     const __m256i w = _mm256_loadu_si256((const __m256i *)(const void *)(y + 4u * (size_t)p));
     U = _mm256_and_si256(w, ff); Y0 = _mm256_and_si256(_mm256_srli_epi32(w, 8), ff);
     V = _mm256_and_si256(_mm256_srli_epi32(w, 16), ff); Y1 = _mm256_srli_epi32(w, 24); })
 /* planar luma: 16 bytes widened to 8 lanes of two pixels each */
-CYL_EXTEND_AVX2(cyl_extend_nv12_avx2, {
+CYL_GATHER_AVX2(cyl_gather_nv12_avx2, {
     const __m256i l = _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(y + 2u * (size_t)p)));
     const __m256i c = _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(u + 2u * (size_t)p)));
     Y0 = _mm256_and_si256(l, ff); Y1 = _mm256_srli_epi32(l, 8);
     U = _mm256_and_si256(c, ff); V = _mm256_srli_epi32(c, 8); })
-CYL_EXTEND_AVX2(cyl_extend_i420_avx2, {
+CYL_GATHER_AVX2(cyl_gather_i420_avx2, {
     const __m256i l = _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i *)(const void *)(y + 2u * (size_t)p)));
     Y0 = _mm256_and_si256(l, ff); Y1 = _mm256_srli_epi32(l, 8);
     U = _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(const void *)(u + p)));
     V = _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(const void *)(v + p))); })
+#undef CYL_GATHER_AVX2
+
+/* The box test of the packed formats in 256-bit registers: 8 pairs a load. */
+#define CYL_MASK8_AVX2(b, bl, bh)                                                               \
+    (unsigned)_mm256_movemask_epi8(_mm256_cmpeq_epi8(                                          \
+        _mm256_min_epu8(_mm256_max_epu8(_mm256_loadu_si256((const __m256i *)(const void *)(b)), bl), bh), \
+        _mm256_loadu_si256((const __m256i *)(const void *)(b))))
+CYL_BOX_PACKED(cyl_box_yuyv_avx2, CYL_SKIP_TARGET_AVX2, __m256i, _mm256_set1_epi32, CYL_MASK8_AVX2, 0, 2, 1, 3)
+CYL_BOX_PACKED(cyl_box_uyvy_avx2, CYL_SKIP_TARGET_AVX2, __m256i, _mm256_set1_epi32, CYL_MASK8_AVX2, 1, 3, 0, 2)
+#undef CYL_MASK8_AVX2
+#undef CYL_BOX_PACKED
+
+/* The AVX2 run extension: the box test, then at the pair it stops at an exact lookup
+ * (cyl_colortable_mask). A pair of another class ends the run there (where runs usually end: no
+ * gathers); a pair of class cur means the run's colours leave the box, and the rest of the run
+ * takes the exact test by gathers. The box is a subset of the class, so the answer is the exact
+ * lookup's in every case; an empty box leaves the whole run to the gathers. PAIR gives pair q's
+ * Y0, Y1, U, V. */
+#define CYL_LOWBIT_IS(m, cur) (((unsigned)(m) & ((2u << (cur)) - 1u)) == (1u << (cur)))
+#define CYL_EXTEND_AVX2(NAME, BOX, GATHER, Y0, Y1, U, V)                                       \
+    CYL_SKIP_TARGET_AVX2 static uint32_t NAME(const cyl_colortable *t, const uint8_t *y,       \
+                                              const uint8_t *u, const uint8_t *v, uint32_t p,  \
+                                              uint32_t n, unsigned cur)                        \
+    {                                                                                          \
+        const uint32_t q = BOX(t, y, u, v, p, n, cur);                                         \
+        (void)u; (void)v;                                                                      \
+        if (q >= n || !CYL_LOWBIT_IS(cyl_colortable_mask(t, Y0, U, V), cur) ||                \
+            !CYL_LOWBIT_IS(cyl_colortable_mask(t, Y1, U, V), cur))                             \
+            return q;                                                                          \
+        return GATHER(t, y, u, v, q + 1u, n, cur);                                             \
+    }
+CYL_EXTEND_AVX2(cyl_extend_yuyv_avx2, cyl_box_yuyv_avx2, cyl_gather_yuyv_avx2,
+                y[4u * q], y[4u * q + 2u], y[4u * q + 1u], y[4u * q + 3u])
+CYL_EXTEND_AVX2(cyl_extend_uyvy_avx2, cyl_box_uyvy_avx2, cyl_gather_uyvy_avx2,
+                y[4u * q + 1u], y[4u * q + 3u], y[4u * q], y[4u * q + 2u])
+CYL_EXTEND_AVX2(cyl_extend_nv12_avx2, cyl_extend_nv12_sse, cyl_gather_nv12_avx2,
+                y[2u * q], y[2u * q + 1u], u[2u * q], u[2u * q + 1u])
+CYL_EXTEND_AVX2(cyl_extend_i420_avx2, cyl_extend_i420_sse, cyl_gather_i420_avx2,
+                y[2u * q], y[2u * q + 1u], u[q], v[q])
 #undef CYL_EXTEND_AVX2
+#undef CYL_LOWBIT_IS
 
 /* CYL_SKIP_MAX_X86 (build option): 1 = SSSE3 at most, 2 = AVX2 at most (default). */
 #ifndef CYL_SKIP_MAX_X86
@@ -338,6 +447,10 @@ static inline cyl_skip_set cyl_skip_select(void)
         s.uyvy = cyl_skip_uyvy_ssse3;
         s.nv12 = cyl_skip_nv12_ssse3;
         s.i420 = cyl_skip_i420_ssse3;
+        s.ext_yuyv = cyl_extend_yuyv_sse;
+        s.ext_uyvy = cyl_extend_uyvy_sse;
+        s.ext_nv12 = cyl_extend_nv12_sse;
+        s.ext_i420 = cyl_extend_i420_sse;
         s.name = "ssse3";
     }
     return s;
@@ -392,10 +505,46 @@ CYL_SKIP_NEON_FN(cyl_skip_nv12_neon, { uint8x16x2_t q = vld2q_u8(u + 2u * (size_
 CYL_SKIP_NEON_FN(cyl_skip_i420_neon, { un = vld1q_u8(u + p); vn = vld1q_u8(v + p); })
 #undef CYL_SKIP_NEON_FN
 
+/* The run extension on NEON: 16 pairs at a time against class cur's inner box, ending at the first
+ * pair with a value outside it (as the SSE extension; the scalar path decides that pair). LOAD sets
+ * the pairs' Y0, Y1, U and V, one pair a lane. */
+#define CYL_EXTEND_NEON_FN(NAME, LOAD)                                                         \
+    static uint32_t NAME(const cyl_colortable *t, const uint8_t *y, const uint8_t *u,          \
+                         const uint8_t *v, uint32_t p, uint32_t n, unsigned cur)               \
+    {                                                                                          \
+        const uint8_t *lo = t->inner_lo[cur], *hi = t->inner_hi[cur];                          \
+        const uint8x16_t yl = vdupq_n_u8(lo[0]), yh = vdupq_n_u8(hi[0]), ul = vdupq_n_u8(lo[1]), \
+                         uh = vdupq_n_u8(hi[1]), vl = vdupq_n_u8(lo[2]), vh = vdupq_n_u8(hi[2]); \
+        (void)u; (void)v;                                                                      \
+        if (lo[0] > hi[0]) return p;                                                           \
+        for (; p + 16u <= n; p += 16u) {                                                       \
+            uint8x16_t Y0, Y1, U, V, in;                                                       \
+            uint64_t m;                                                                        \
+            LOAD                                                                               \
+            in = vandq_u8(vandq_u8(vcgeq_u8(Y0, yl), vcleq_u8(Y0, yh)), vandq_u8(vcgeq_u8(Y1, yl), vcleq_u8(Y1, yh))); \
+            in = vandq_u8(in, vandq_u8(vandq_u8(vcgeq_u8(U, ul), vcleq_u8(U, uh)), vandq_u8(vcgeq_u8(V, vl), vcleq_u8(V, vh)))); \
+            /* 4 bits a lane, set where the lane is outside the box */                          \
+            m = vget_lane_u64(vreinterpret_u64_u8(vshrn_n_u16(vreinterpretq_u16_u8(vmvnq_u8(in)), 4)), 0); \
+            if (m) return p + ((uint32_t)__builtin_ctzll(m) >> 2);                             \
+        }                                                                                      \
+        return p;                                                                              \
+    }
+CYL_EXTEND_NEON_FN(cyl_extend_yuyv_neon, { uint8x16x4_t q = vld4q_u8(y + 4u * (size_t)p);
+                                           Y0 = q.val[0]; U = q.val[1]; Y1 = q.val[2]; V = q.val[3]; })
+CYL_EXTEND_NEON_FN(cyl_extend_uyvy_neon, { uint8x16x4_t q = vld4q_u8(y + 4u * (size_t)p);
+                                           U = q.val[0]; Y0 = q.val[1]; V = q.val[2]; Y1 = q.val[3]; })
+CYL_EXTEND_NEON_FN(cyl_extend_nv12_neon, { uint8x16x2_t l = vld2q_u8(y + 2u * (size_t)p);
+                                           uint8x16x2_t c = vld2q_u8(u + 2u * (size_t)p);
+                                           Y0 = l.val[0]; Y1 = l.val[1]; U = c.val[0]; V = c.val[1]; })
+CYL_EXTEND_NEON_FN(cyl_extend_i420_neon, { uint8x16x2_t l = vld2q_u8(y + 2u * (size_t)p);
+                                           Y0 = l.val[0]; Y1 = l.val[1]; U = vld1q_u8(u + p); V = vld1q_u8(v + p); })
+#undef CYL_EXTEND_NEON_FN
+
 static inline cyl_skip_set cyl_skip_select(void)
 {
     cyl_skip_set s = { cyl_skip_yuyv_neon, cyl_skip_uyvy_neon, cyl_skip_nv12_neon, cyl_skip_i420_neon,
-                       0, 0, 0, 0, "neon" };
+                       cyl_extend_yuyv_neon, cyl_extend_uyvy_neon, cyl_extend_nv12_neon,
+                       cyl_extend_i420_neon, "neon" };
     return s;
 }
 

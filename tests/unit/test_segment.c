@@ -580,6 +580,127 @@ static void test_chroma_map_kept(void **state)
     free(buf);
 }
 
+/* Every colour of a class's inner box has that class (the run extension's byte-compare test relies
+ * on it): all colours of a box of up to 50,000, else its corners and 50,000 random ones. */
+static void check_inner_boxes(const cyl_colortable *t, test_rng *rng, int refreshed)
+{
+    unsigned c;
+    for (c = 0; c < CYL_MAX_CLASSES; c++) {
+        const uint8_t *lo = t->inner_lo[c], *hi = t->inner_hi[c];
+        unsigned long vol;
+        if (lo[0] > hi[0] || lo[1] > hi[1] || lo[2] > hi[2]) {
+            if (refreshed) {   /* refresh leaves a box empty only for a class no cell centre has */
+                unsigned yc, uc, vc;
+                for (yc = 0; yc < CYL_YUV_NY; yc++)
+                    for (uc = 0; uc < CYL_YUV_NC; uc++)
+                        for (vc = 0; vc < CYL_YUV_NC; vc++)
+                            assert_int_not_equal(cyl_mask_class(cyl_colortable_mask(t, (uint8_t)(yc * 8u + 4u),
+                                                                                    (uint8_t)(uc * 4u + 2u),
+                                                                                    (uint8_t)(vc * 4u + 2u))), c);
+            }
+            continue;
+        }
+        vol = (unsigned long)(hi[0] - lo[0] + 1u) * (hi[1] - lo[1] + 1u) * (hi[2] - lo[2] + 1u);
+        if (vol <= 50000ul) {
+            unsigned Y, U, V;
+            for (Y = lo[0]; Y <= hi[0]; Y++)
+                for (U = lo[1]; U <= hi[1]; U++)
+                    for (V = lo[2]; V <= hi[2]; V++)
+                        if (cyl_mask_class(cyl_colortable_mask(t, (uint8_t)Y, (uint8_t)U, (uint8_t)V)) != c)
+                            fail_msg("class %u: (%u, %u, %u) in its inner box is not of the class", c, Y, U, V);
+        } else {
+            unsigned i;
+            for (i = 0; i < 50008u; i++) {
+                const unsigned Y = i < 8u ? (i & 1u ? hi[0] : lo[0]) : (unsigned)test_rng_int(rng, lo[0], hi[0]);
+                const unsigned U = i < 8u ? (i & 2u ? hi[1] : lo[1]) : (unsigned)test_rng_int(rng, lo[1], hi[1]);
+                const unsigned V = i < 8u ? (i & 4u ? hi[2] : lo[2]) : (unsigned)test_rng_int(rng, lo[2], hi[2]);
+                if (cyl_mask_class(cyl_colortable_mask(t, (uint8_t)Y, (uint8_t)U, (uint8_t)V)) != c)
+                    fail_msg("class %u: (%u, %u, %u) in its inner box is not of the class", c, Y, U, V);
+            }
+        }
+    }
+}
+
+static void test_inner_boxes(void **state)
+{
+    test_rng rng;
+    cyl_colortable t;
+    uint8_t *buf = (uint8_t *)malloc(CYL_TABLE_FILE_MAX_SIZE);
+    size_t len;
+    int i, nonempty = 0;
+    (void)state;
+    /* disjoint boxes: each class's inner box is its box, whole */
+    cyl_colortable_init(&t);
+    for (i = 0; i < CYL_MAX_CLASSES; i++) assert_true(t.inner_lo[i][0] > t.inner_hi[i][0]);   /* empty */
+    cyl_colortable_add_box(&t, 0, 60, 240, 70, 90, 180, 200);
+    cyl_colortable_add_box(&t, 1, 60, 240, 50, 70, 60, 80);
+    cyl_colortable_refresh(&t);
+    {
+        static const uint8_t want[2][6] = { { 60, 70, 180, 240, 90, 200 }, { 60, 50, 60, 240, 70, 80 } };
+        for (i = 0; i < 2; i++) {
+            assert_memory_equal(t.inner_lo[i], want[i], 3);
+            assert_memory_equal(t.inner_hi[i], want[i] + 3, 3);
+        }
+    }
+    /* an overlapping box of an earlier class empties the later boxes; clearing a class its own */
+    cyl_colortable_add_box(&t, 0, 0, 255, 60, 75, 70, 190);
+    assert_true(t.inner_lo[0][0] <= t.inner_hi[0][0]);
+    assert_true(t.inner_lo[1][0] > t.inner_hi[1][0]);
+    check_inner_boxes(&t, &rng, 0);
+    cyl_colortable_refresh(&t);
+    assert_true(t.inner_lo[1][0] <= t.inner_hi[1][0]);
+    assert_true(t.inner_lo[1][1] > 75 || t.inner_lo[1][2] > 190 || t.inner_hi[1][2] < 70);
+    cyl_colortable_clear_class(&t, 0);
+    assert_true(t.inner_lo[0][0] > t.inner_hi[0][0]);
+    assert_true(t.inner_lo[1][0] <= t.inner_hi[1][0]);
+    /* random tables: boxes, clears, hand edits of uv, y and yuv */
+    test_rng_seed(&rng, 20261204);
+    cyl_colortable_init(&t);
+    for (i = 0; i < 150; i++) {
+        unsigned cls = (unsigned)test_rng_int(&rng, 0, 7);
+        int op = (int)test_rng_int(&rng, 0, 9), refreshed = 0;
+        if (op < 6) {
+            uint8_t u0 = (uint8_t)test_rng_int(&rng, 0, 255), v0 = (uint8_t)test_rng_int(&rng, 0, 255);
+            uint8_t y0 = (uint8_t)test_rng_int(&rng, 0, 200);
+            uint8_t u1 = (uint8_t)test_rng_int(&rng, u0, u0 + 40 > 255 ? 255 : u0 + 40);
+            uint8_t v1 = (uint8_t)test_rng_int(&rng, v0, v0 + 40 > 255 ? 255 : v0 + 40);
+            assert_int_equal(cyl_colortable_add_box(&t, cls, y0, (uint8_t)test_rng_int(&rng, y0, 255), u0, u1, v0, v1),
+                             CYL_OK);
+            if (op < 3) { cyl_colortable_refresh(&t); refreshed = 1; }
+        } else if (op < 7) {
+            assert_int_equal(cyl_colortable_clear_class(&t, cls), CYL_OK);
+        } else {
+            /* hand edits across a class's colours, then refresh */
+            unsigned k, yc = (unsigned)test_rng_int(&rng, 0, CYL_YUV_NY - 1);
+            for (k = 0; k < 40u; k++) {
+                t.uv[test_rng_int(&rng, 0, 255)][test_rng_int(&rng, 0, 255)] ^= (cyl_mask)(1u << cls);
+                t.yuv[yc][test_rng_int(&rng, 0, CYL_YUV_NC - 1)][test_rng_int(&rng, 0, CYL_YUV_NC - 1)] ^=
+                    (cyl_mask)(1u << test_rng_int(&rng, 0, 7));
+            }
+            t.y[test_rng_int(&rng, 0, 255)] ^= (cyl_mask)(1u << cls);
+            cyl_colortable_refresh(&t);
+            refreshed = 1;
+        }
+        check_inner_boxes(&t, &rng, refreshed);
+        if (refreshed) {
+            unsigned c;
+            for (c = 0; c < CYL_MAX_CLASSES; c++) nonempty += t.inner_lo[c][0] <= t.inner_hi[c][0];
+        }
+    }
+    assert_true(nonempty > 200);   /* boxes were there to check */
+    /* a loaded table has the boxes refresh computes */
+    assert_int_equal(cyl_colortable_save(&t, buf, CYL_TABLE_FILE_MAX_SIZE, &len), CYL_OK);
+    {
+        cyl_colortable t2;
+        cyl_colortable_refresh(&t);
+        cyl_colortable_init(&t2);
+        assert_int_equal(cyl_colortable_load(&t2, buf, len), CYL_OK);
+        assert_memory_equal(t2.inner_lo, t.inner_lo, sizeof t.inner_lo);
+        assert_memory_equal(t2.inner_hi, t.inner_hi, sizeof t.inner_hi);
+    }
+    free(buf);
+}
+
 /* The vector background skip against the scalar reference path: bit-identical runs and
  * blobs on random wide frames (every 4:2:x format, ROIs, odd starts), with random tables
  * whose classes cover small chroma boxes, so that the coarse map's 16x16 blocks are often
@@ -606,7 +727,7 @@ static void test_vector_path_identical(void **state)
         cyl_segment_params p = cyl_segment_params_default();
         uint32_t w = (uint32_t)test_rng_int(&rng, 1, 700), h = (uint32_t)test_rng_int(&rng, 1, 12);
         cyl_pixfmt fmt = fmts[test_rng_int(&rng, 0, 3)];
-        uint8_t col[3][3];
+        uint8_t col[3][3], lo[3][2], span[3][2];
         unsigned k, n_cls = (unsigned)test_rng_int(&rng, 1, 3);
         uint32_t i, j;
         double p_col = test_rng_uniform(&rng) * 0.2;
@@ -617,6 +738,7 @@ static void test_vector_path_identical(void **state)
             uint8_t u0 = (uint8_t)test_rng_int(&rng, 0, 230), v0 = (uint8_t)test_rng_int(&rng, 0, 230);
             uint8_t du = (uint8_t)test_rng_int(&rng, 0, 25), dv = (uint8_t)test_rng_int(&rng, 0, 25);
             cyl_colortable_add_box(&t, k, 30, 240, u0, (uint8_t)(u0 + du), v0, (uint8_t)(v0 + dv));
+            lo[k][0] = u0; lo[k][1] = v0; span[k][0] = du; span[k][1] = dv;
             col[k][0] = (uint8_t)test_rng_int(&rng, 30, 240);
             col[k][1] = (uint8_t)(u0 + du / 2);
             col[k][2] = (uint8_t)(v0 + dv / 2);
@@ -647,7 +769,9 @@ static void test_vector_path_identical(void **state)
             assert_int_equal(t.lookup, CYL_LOOKUP_YUV);
             break;
         }
-        default:
+        default:   /* boxes alone; every other such table refreshed, which computes the inner boxes
+                      of the run extension (adding a box leaves them empty) */
+            if (iter % 2) cyl_colortable_refresh(&t);
             break;
         }
         assert_true(canvas_alloc(&c, w, h));
@@ -657,6 +781,12 @@ static void test_vector_path_identical(void **state)
                 if (test_rng_uniform(&rng) < p_col) {
                     k = (unsigned)test_rng_int(&rng, 0, (int64_t)n_cls - 1);
                     c.y[o] = col[k][0]; c.u[o] = col[k][1]; c.v[o] = col[k][2];
+                    if (test_rng_int(&rng, 0, 1)) {   /* anywhere in the class's box: often outside
+                                                          its inner box, still of the class */
+                        c.y[o] = (uint8_t)test_rng_int(&rng, 30, 240);
+                        c.u[o] = (uint8_t)(lo[k][0] + test_rng_int(&rng, 0, span[k][0]));
+                        c.v[o] = (uint8_t)(lo[k][1] + test_rng_int(&rng, 0, span[k][1]));
+                    }
                 } else {
                     /* background: grey-ish, or any chroma near a class's block */
                     c.y[o] = (uint8_t)test_rng_int(&rng, 0, 255);
@@ -834,6 +964,9 @@ static void test_vector_path_name(void **state)
 #if defined(__arm__) && !defined(__ARM_NEON)
     assert_string_equal(n, "scalar");
 #endif
+#if defined(CYL_EXPECT_VECTOR_PATH)   /* a build that forces a path (mk/config.mk) */
+    assert_string_equal(n, CYL_EXPECT_VECTOR_PATH);
+#endif
 }
 
 static void test_deterministic(void **state)
@@ -905,6 +1038,7 @@ int main(void)
         cmocka_unit_test(test_bruteforce_random),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_chroma_map_kept),
+        cmocka_unit_test(test_inner_boxes),
         cmocka_unit_test(test_vector_path_identical),
         cmocka_unit_test(test_vector_path_name),
         cmocka_unit_test(test_bands_join_identical),

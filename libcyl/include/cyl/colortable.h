@@ -71,6 +71,15 @@ typedef struct cyl_colortable {
                                                          levels); a superset is correct, a missing bit is
                                                          not; kept by every function here and by
                                                          cyl_colortable_refresh() */
+    uint8_t inner_lo[CYL_MAX_CLASSES][3];             /* a box of colours certainly of each class, for the
+                                                         vector run extension: every (Y, U, V) with
+                                                         inner_lo[c][k] <= (Y, U, V)[k] <= inner_hi[c][k]
+                                                         (k = 0, 1, 2) has class c (the lowest bit of its
+                                                         mask); empty (a lo above its hi) when not known.
+                                                         A smaller box is correct, a larger one is not. Set
+                                                         by cyl_colortable_refresh(); the editing functions
+                                                         here empty the boxes an edit may invalidate */
+    uint8_t inner_hi[CYL_MAX_CLASSES][3];             /* the box's upper corner (Y, U, V), inclusive */
     char name[CYL_MAX_CLASSES][CYL_CLASS_NAME_LEN];   /* NUL-terminated class names ("" = unused) */
     uint8_t rgb[CYL_MAX_CLASSES][3];                  /* display colour of each class (overlays), 0..255 */
 } cyl_colortable;
@@ -117,8 +126,10 @@ static inline cyl_mask cyl_colortable_mask(const cyl_colortable *t, uint8_t Y, u
 /* 1 if any class has a brightness-dependent (3-D) part, i.e. some yuv cell is not all ones. */
 int cyl_colortable_has_yuv(const cyl_colortable *t);
 
-/* Recompute t->lookup, t->live and t->chroma_any from the table's contents (after editing
- * uv, y or yuv by hand).
+/* Recompute t->lookup, t->live, t->chroma_any and the inner boxes from the table's contents
+ * (after editing uv, y or yuv by hand, and after cyl_colortable_add_box() for the fastest
+ * segmentation: adding a box empties the inner boxes of the classes after it, which is correct
+ * but leaves their runs to the exact per-pixel test; loading a table file refreshes it).
  * A lookup field with extra bits set is still correct, only slower; one with a bit
  * missing makes segmentation disagree with cyl_colortable_mask(). */
 void cyl_colortable_refresh(cyl_colortable *t);
