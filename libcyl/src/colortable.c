@@ -3,6 +3,13 @@
 #include "internal.h"
 #include <string.h>
 
+/* An empty inner box: every lower corner above its upper corner. */
+static void inner_empty(cyl_colortable *t, unsigned c)
+{
+    memset(t->inner_lo[c], 0xFF, 3);
+    memset(t->inner_hi[c], 0, 3);
+}
+
 void cyl_colortable_init(cyl_colortable *t)
 {
     unsigned i;
@@ -13,7 +20,7 @@ void cyl_colortable_init(cyl_colortable *t)
     memset(t->weak_of, CYL_CLASS_NONE, sizeof t->weak_of);
     for (i = 0; i < CYL_MAX_CLASSES; i++) {
         t->rgb[i][0] = t->rgb[i][1] = t->rgb[i][2] = 128;
-        memset(t->inner_lo[i], 0xFF, 3);   /* empty inner boxes */
+        inner_empty(t, i);
     }
 }
 
@@ -73,12 +80,6 @@ static void chroma_any_update(cyl_colortable *t)
 
 /* ---- inner boxes (the vector run extension's fast test) --------------------- */
 
-static void inner_empty(cyl_colortable *t, unsigned c)
-{
-    memset(t->inner_lo[c], 0xFF, 3);
-    memset(t->inner_hi[c], 0, 3);
-}
-
 /* Is every colour of the box [lo, hi] ((Y, U, V), inclusive) of class c? Within each 3-D cell the
  * box's uv and y entries are combined through their AND (for c's bit: every colour has it) and
  * their OR (for the lower classes' bits: no colour can have one), so the answer may be no for a
@@ -119,8 +120,7 @@ static void inner_grow(cyl_colortable *t, unsigned c, const unsigned seed[3])
 {
     unsigned lo[3], hi[3], step[6], k, open = 0x3Fu;
     for (k = 0; k < 3; k++) lo[k] = hi[k] = seed[k];
-    inner_empty(t, c);
-    if (!inner_ok(t, c, lo, hi)) return;
+    if (!inner_ok(t, c, lo, hi)) return;   /* the box stays empty (inner_update emptied it) */
     for (k = 0; k < 6; k++) step[k] = 16u;
     while (open) {
         for (k = 0; k < 6; k++) {

@@ -34,6 +34,7 @@
 
 #include <stdint.h>
 #include "cyl/colortable.h"
+#include "lowbit.h"
 
 /* u: pointer to pair 0's bytes (packed formats: the row; NV12: the interleaved chroma row;
  * I420: the U row), v: I420's V row (else unused). */
@@ -382,7 +383,6 @@ CYL_BOX_PACKED(cyl_box_uyvy_avx2, CYL_SKIP_TARGET_AVX2, __m256i, _mm256_set1_epi
  * takes the exact test by gathers. The box is a subset of the class, so the answer is the exact
  * lookup's in every case; an empty box leaves the whole run to the gathers. PAIR gives pair q's
  * Y0, Y1, U, V. */
-#define CYL_LOWBIT_IS(m, cur) (((unsigned)(m) & ((2u << (cur)) - 1u)) == (1u << (cur)))
 #define CYL_EXTEND_AVX2(NAME, BOX, GATHER, Y0, Y1, U, V)                                       \
     CYL_SKIP_TARGET_AVX2 static uint32_t NAME(const cyl_colortable *t, const uint8_t *y,       \
                                               const uint8_t *u, const uint8_t *v, uint32_t p,  \
@@ -390,8 +390,8 @@ CYL_BOX_PACKED(cyl_box_uyvy_avx2, CYL_SKIP_TARGET_AVX2, __m256i, _mm256_set1_epi
     {                                                                                          \
         const uint32_t q = BOX(t, y, u, v, p, n, cur);                                         \
         (void)u; (void)v;                                                                      \
-        if (q >= n || !CYL_LOWBIT_IS(cyl_colortable_mask(t, Y0, U, V), cur) ||                \
-            !CYL_LOWBIT_IS(cyl_colortable_mask(t, Y1, U, V), cur))                             \
+        if (q >= n || cyl_lowbit[cyl_colortable_mask(t, Y0, U, V)] != cur ||                  \
+            cyl_lowbit[cyl_colortable_mask(t, Y1, U, V)] != cur)                               \
             return q;                                                                          \
         return GATHER(t, y, u, v, q + 1u, n, cur);                                             \
     }
@@ -404,7 +404,6 @@ CYL_EXTEND_AVX2(cyl_extend_nv12_avx2, cyl_extend_nv12_sse, cyl_gather_nv12_avx2,
 CYL_EXTEND_AVX2(cyl_extend_i420_avx2, cyl_extend_i420_sse, cyl_gather_i420_avx2,
                 y[2u * q], y[2u * q + 1u], u[q], v[q])
 #undef CYL_EXTEND_AVX2
-#undef CYL_LOWBIT_IS
 
 /* CYL_SKIP_MAX_X86 (build option): 1 = SSSE3 at most, 2 = AVX2 at most (default). */
 #ifndef CYL_SKIP_MAX_X86
