@@ -276,7 +276,9 @@ ObservationLog::ObservationLog(const std::string &path, const Header &h)
         const cyl_camera &c = *h.camera;
         line += ",\"camera\":{\"width\":" + std::to_string(c.width) + ",\"height\":" + std::to_string(c.height) +
                 ",\"fx\":" + num(c.fx_px) + ",\"fy\":" + num(c.fy_px) + ",\"cx\":" + num(c.cx_px) +
-                ",\"cy\":" + num(c.cy_px) + ",\"tilt_rad\":" + num(c.tilt_rad) + ",\"yaw_rad\":" + num(c.yaw_rad) +
+                ",\"cy\":" + num(c.cy_px) + ",\"k1\":" + num(c.k1, 17) + ",\"k2\":" + num(c.k2, 17) +
+                ",\"p1\":" + num(c.p1, 17) + ",\"p2\":" + num(c.p2, 17) + ",\"k3\":" + num(c.k3, 17) +
+                ",\"tilt_rad\":" + num(c.tilt_rad) + ",\"yaw_rad\":" + num(c.yaw_rad) +
                 ",\"height_m\":" + num(c.height_m) + ",\"offset_m\":" + num(c.offset_m) +
                 ",\"calib_cov\":[" + calib_cov_json(c) + "]}";
     }

@@ -24,7 +24,7 @@ import numpy as np
 from ._cyl import ffi, lib
 
 __all__ = ["CylError", "Table", "Blob", "Camera", "CameraFileError", "load_camera", "segment", "observe", "version",
-           "FORMATS"]
+           "RangeBearing", "FORMATS"]
 
 FORMATS = {"YUYV": lib.CYL_FMT_YUYV, "UYVY": lib.CYL_FMT_UYVY, "NV12": lib.CYL_FMT_NV12,
            "I420": lib.CYL_FMT_I420, "YU12": lib.CYL_FMT_I420}
@@ -265,6 +265,44 @@ def observe(table: Table, frame: np.ndarray, fmt: str, camera: Camera,
             out[-1]["subpixel_shift_px"] = [o.subpixel_du_px, o.subpixel_dv_px]
     del keep
     return out
+
+
+class RangeBearing:
+    """libcyl's camera model (cyl/rangebearing.h, cyl_rb_eval): a measured point (u, v) px to the
+    landmark's range_m and bearing_rad from the robot centre, at the camera's calibration moved by
+    an error delta = (fx, fy, cx, cy px, tilt, yaw rad, h, s m) -- the order of the observation's
+    jac_calib -- with analytic Jacobians. What a SLAM back end that estimates the calibration
+    needs: the model evaluated where the estimate is, not its linearisation at the nominal values."""
+
+    CALIB_INPUTS = (2, 3, 4, 5, 11, 12, 13, 14)   # CYL_IN_FX .. CYL_IN_S of the delta's entries
+    GEOM = {"exact": lib.CYL_GEOM_EXACT, "paper": lib.CYL_GEOM_PAPER}
+
+    def __init__(self, camera: Camera, model: str = "exact"):
+        if model not in self.GEOM:
+            raise ValueError(f"model '{model}': one of {sorted(self.GEOM)}")
+        self.model = self.GEOM[model]
+        n = lib.CYL_IN_COUNT
+        nominal = ffi.new("double[]", n)
+        lib.cyl_rb_inputs(camera._c, 0.0, 0.0, nominal)
+        self.nominal = np.array([nominal[k] for k in range(n)])
+        self._in = ffi.new("double[]", n)
+        self._out = ffi.new("double[2]")
+        self._jac = ffi.new("double[2][15]")
+        self._inbuf = np.frombuffer(ffi.buffer(self._in), dtype=np.float64)
+        self._jacbuf = np.frombuffer(ffi.buffer(self._jac), dtype=np.float64).reshape(2, 15)
+
+    def eval(self, u_px: float, v_px: float, delta=None):
+        """(range_m, bearing_rad, jac) with jac the 2x15 d(range, bearing)/d(inputs) (input order
+        of cyl/rangebearing.h: u, v, fx, fy, cx, cy, k1, k2, p1, p2, k3, tilt, yaw, h, s), or None
+        when the ray does not meet the floor (no range) or the model fails there."""
+        self._inbuf[:] = self.nominal
+        self._inbuf[0], self._inbuf[1] = u_px, v_px
+        if delta is not None:
+            self._inbuf[list(self.CALIB_INPUTS)] += np.asarray(delta, float)
+        st = lib.cyl_rb_eval(self._in, self.model, self._out, ffi.NULL, self._jac, ffi.NULL)
+        if st != 0:
+            return None
+        return self._out[0], self._out[1], self._jacbuf.copy()
 
 
 from .camera_file import CameraFileError, load_camera  # noqa: E402  (needs Camera above)

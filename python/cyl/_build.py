@@ -89,11 +89,16 @@ cyl_observe_params cyl_observe_params_default_frame(void);
 size_t cyl_observe_work_size(const cyl_segmentation *seg, const cyl_observe_params *p);
 cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam, const cyl_observe_params *p, void *work,
                        size_t work_size, cyl_observation *out, uint32_t cap, uint32_t *n_out);
+
+#define CYL_IN_COUNT ...
+void cyl_rb_inputs(const cyl_camera *cam, double u_px, double v_px, double in[]);
+cyl_status cyl_rb_eval(const double in[], cyl_geom_model model, double out[2], double xy[2], double jac[][15],
+                       double jac_xy[][15]);
 """)
 ffibuilder.set_source(
     "cyl._cyl",
     '#include "cyl/status.h"\n#include "cyl/version.h"\n#include "cyl/image.h"\n#include "cyl/colortable.h"\n'
-    '#include "cyl/segment.h"\n#include "cyl/camera.h"\n#include "cyl/observe.h"\n',
+    '#include "cyl/segment.h"\n#include "cyl/camera.h"\n#include "cyl/observe.h"\n#include "cyl/rangebearing.h"\n',
     # under pip: paths relative to the repository (setuptools wants relative ones; its objects go
     # to its own build folder); in place (CYL_CFFI_TMPDIR, python/run_tests.sh): absolute, so
     # that the objects land under that folder and never beside the sources

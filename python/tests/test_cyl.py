@@ -124,13 +124,21 @@ def camera_from_yaml(path):
                       offset_sigma_m=num("mount_offset_sigma_m"))
 
 
-@pytest.mark.skipif(not os.path.exists(os.path.join(BUILD, "cyl")), reason="needs build/cyl and build/cyl-render")
-def test_observations_equal_the_c_tools(tmp_path):
+def _render_and_detect(tmp_path, frames, seed):
+    """Render `frames` frames of the default scene with cyl-render and detect them with cyl detect
+    (the synthetic camera's calibration): returns (calibration file, observation log, raw log)."""
     raw, log = str(tmp_path / "d.cylraw"), str(tmp_path / "o.jsonl")
     calib = os.path.join(ROOT, "calib_data", "synthetic_camera.yaml")
-    subprocess.run([os.path.join(BUILD, "cyl-render"), "-o", raw, "-n", "6", "-s", "3", "-q"], check=True)
+    subprocess.run([os.path.join(BUILD, "cyl-render"), "-o", raw, "-n", str(frames), "-s", str(seed), "-q"],
+                   check=True)
     subprocess.run([os.path.join(BUILD, "cyl"), "detect", raw, "--table", TABLE, "--calib", calib, "--size",
                     "orange=0.10,0.30", "--size", "green=0.10,0.30", "--out", log, "--quiet"], check=True)
+    return calib, log, raw
+
+
+@pytest.mark.skipif(not os.path.exists(os.path.join(BUILD, "cyl")), reason="needs build/cyl and build/cyl-render")
+def test_observations_equal_the_c_tools(tmp_path):
+    calib, log, raw = _render_and_detect(tmp_path, frames=6, seed=3)
     by_seq = {}
     for line in open(log):
         r = json.loads(line)
@@ -154,3 +162,73 @@ def test_observations_equal_the_c_tools(tmp_path):
             assert g["subpixel_shift_px"] == pytest.approx(c["subpixel_shift_px"], rel=1e-8, abs=1e-12)
             n += 1
     assert n >= 6
+
+
+def _rb_by_hand(cam, u, v):
+    """Range and bearing of a pixel of a camera without distortion, from the ray-plane formulas of
+    cyl/rangebearing.h written out again here (an independent derivation for the test)."""
+    f = cam.fields()
+    xn, yn = (u - f["cx_px"]) / f["fx_px"], (v - f["cy_px"]) / f["fy_px"]
+    t = f["tilt_rad"]
+    X, Y, Z = np.cos(t) - yn * np.sin(t), xn, np.sin(t) + yn * np.cos(t)
+    dc = f["height_m"] * np.hypot(X, Y) / Z
+    th = f["yaw_rad"] - np.arctan2(Y, X)
+    x, y = f["offset_m"] + dc * np.cos(th), dc * np.sin(th)
+    return np.hypot(x, y), np.arctan2(y, x)
+
+
+def test_range_bearing_model():
+    """cyl.RangeBearing: the C model by hand on a lens without distortion, a calibration error equal
+    to a camera moved by it, its Jacobians by central differences, None above the horizon, and the
+    observation log's range and bearing reproduced from its pixel and its header's camera."""
+    cam = cyl.Camera(640, 480, fx=570, fy=568, cx=322.4, cy=236.9, tilt_rad=0.2094, yaw_rad=0.01,
+                     height_m=0.326, offset_m=0.1)
+    rb = cyl.RangeBearing(cam)
+    for u, v in ((320.0, 300.0), (40.5, 200.25), (600.0, 470.0)):
+        r, b, _ = rb.eval(u, v)
+        rr, bb = _rb_by_hand(cam, u, v)
+        assert r == pytest.approx(rr, rel=1e-12) and b == pytest.approx(bb, abs=1e-12)
+    delta = np.array([0.5, -0.4, 0.3, -0.2, 0.01, -0.004, 0.002, -0.003])
+    moved = cyl.Camera(640, 480, fx=570.5, fy=567.6, cx=322.7, cy=236.7, tilt_rad=0.2194, yaw_rad=0.006,
+                       height_m=0.328, offset_m=0.097)
+    got, want = rb.eval(100.0, 260.0, delta), cyl.RangeBearing(moved).eval(100.0, 260.0)
+    assert got[0] == pytest.approx(want[0], rel=1e-12) and got[1] == pytest.approx(want[1], abs=1e-12)
+    # Jacobians: u, v and the eight calibration entries, by central differences
+    u, v = 150.0, 300.0
+    _, _, jac = rb.eval(u, v, delta)
+    steps = [1e-4, 1e-4] + [1e-4, 1e-4, 1e-4, 1e-4, 1e-7, 1e-7, 1e-7, 1e-7]
+    cols = [0, 1] + list(cyl.RangeBearing.CALIB_INPUTS)
+    for k, (c, h) in enumerate(zip(cols, steps)):
+        def at(s):
+            if k < 2:
+                return np.array(rb.eval(u + s * (k == 0), v + s * (k == 1), delta)[:2])
+            d = delta.copy()
+            d[k - 2] += s
+            return np.array(rb.eval(u, v, d)[:2])
+        num = (at(h) - at(-h)) / (2 * h)
+        assert jac[:, c] == pytest.approx(num, rel=1e-5, abs=1e-9), c
+    assert rb.eval(320.0, 20.0) is None              # above the horizon: no range
+    with pytest.raises(ValueError):
+        cyl.RangeBearing(cam, "pinhole")
+
+
+@pytest.mark.skipif(not os.path.exists(os.path.join(BUILD, "cyl")), reason="needs build/cyl and build/cyl-render")
+def test_range_bearing_reproduces_the_log(tmp_path):
+    calib, log, _ = _render_and_detect(tmp_path, frames=4, seed=5)
+    lines = [json.loads(x) for x in open(log)]
+    c = lines[0]["camera"]
+    cam = cyl.Camera(c["width"], c["height"], c["fx"], c["fy"], c["cx"], c["cy"], k1=c["k1"], k2=c["k2"],
+                     p1=c["p1"], p2=c["p2"], k3=c["k3"], tilt_rad=c["tilt_rad"], yaw_rad=c["yaw_rad"],
+                     height_m=c["height_m"], offset_m=c["offset_m"])
+    assert c["k1"] == camera_from_yaml(calib).fields()["k1"]
+    rb = cyl.RangeBearing(cam, lines[0]["model"])
+    n = 0
+    for o in lines:
+        if o["type"] != "obs" or o["flags"] & 0x300:
+            continue
+        r, b, jac = rb.eval(o["u_px"], o["v_px"])
+        assert r == pytest.approx(o["range_m"], rel=1e-8) and b == pytest.approx(o["bearing_rad"], abs=1e-9)
+        got = jac[:, list(cyl.RangeBearing.CALIB_INPUTS)].ravel()
+        assert got == pytest.approx(o["jac_calib"], rel=1e-7, abs=1e-12)
+        n += 1
+    assert n >= 4

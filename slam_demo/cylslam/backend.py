@@ -38,6 +38,7 @@ from typing import Optional
 import gtsam
 import numpy as np
 
+from .camera_model import range_bearing_model
 from .data import FLAG_NO_RANGE, FLAGS_REJECT, compose, rb_to_world, wrap
 
 PERM = np.array([[0.0, 1.0], [1.0, 0.0]])
@@ -132,6 +133,61 @@ def calib_factor(pose_key, lm_key, o, noise, bias_key=None):
     return gtsam.CustomFactor(noise, keys, error)
 
 
+def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_key=None):
+    """As calib_factor, with libcyl's camera model evaluated at the estimated calibration instead of
+    its linearisation at the nominal one (rbm: camera_model.range_bearing_model). The predicted
+    measurement is m(delta, b) = cyl_rb_eval(u - du, v - dv, nominal + delta), so z = h(pose, lm) + n
+    holds however far the range is from linear in the calibration (far observations: the range goes
+    as h / tan(depression), and the tilt is in the depression).
+
+    The noise is the centroid's, which lives in the image: the residual is taken there,
+    e = A(delta)^-1 (h(pose, lm) - m(delta, b)) px with A = d(bearing, range)/d(u, v) at the estimate
+    (to first order the predicted minus the measured centroid), and its covariance is the frame
+    covariance moved into the image at the nominal calibration, A0^-1 cov_frame A0^-T (the centroid's
+    covariance, with the frontend's distortion terms). So the range's noise grows with the range the
+    estimated calibration gives the pixel, not the nominal one's. The bias state enters with the
+    identity (it is a pixel offset). Where the model has no range for a delta the optimiser tries (the
+    ray at or above the horizon), the linearisation at the nominal calibration stands in."""
+    jbr = np.vstack([o.jac_calib[1], o.jac_calib[0]])   # (bearing, range) rows, at the nominal
+    a0 = -jbr[:, 2:4]                                   # d(bearing, range)/d(u, v) = -d/d(cx, cy)
+    a0i = np.linalg.inv(a0)
+    cov_px = a0i @ to_gtsam_cov(cov_frame) @ a0i.T
+    cov_px = 0.5 * (cov_px + cov_px.T)
+    noise = gtsam.noiseModel.Gaussian.Covariance(cov_px)
+    if robust is not None:
+        noise = gtsam.noiseModel.Robust.Create(robust, noise)
+    z = np.array([o.bearing_rad, o.range_m])
+    cal = list(rbm.CALIB_INPUTS)
+
+    def error(this, values, H):
+        p = values.atPose2(pose_key)
+        l = values.atPoint2(lm_key)
+        d = values.atVector(CALIB)
+        bb = values.atVector(bias_key) if bias_key is not None else np.zeros(2)
+        b, r, hp, hl = rb_jacobians((p.x(), p.y(), p.theta()), (l[0], l[1]))
+        m = rbm.eval(o.u_px - bb[0], o.v_px - bb[1], d)
+        if m is not None:
+            zhat = np.array([m[1], m[0]])
+            j = m[2][::-1]                               # (bearing, range) rows
+            jd, a = j[:, cal], j[:, 0:2]
+        else:
+            jd, a = jbr, a0
+            zhat = z + jd @ d - a @ bb
+        e = np.array([b, r]) - zhat
+        e[0] = (e[0] + np.pi) % (2 * np.pi) - np.pi
+        ai = np.linalg.inv(a)
+        if H is not None:
+            H[0] = ai @ hp
+            H[1] = ai @ hl
+            H[2] = -ai @ jd
+            if bias_key is not None:
+                H[3] = np.eye(2)                         # zhat(u - b): d e / d b = A^-1 A
+        return ai @ e
+
+    keys = [pose_key, lm_key, CALIB] + ([bias_key] if bias_key is not None else [])
+    return gtsam.CustomFactor(noise, keys, error)
+
+
 def calib_prior(cov):
     """Prior N(0, cov) on the calibration error; parameters with zero variance (known exactly)
     get a tiny one (1e-12 of the unit) so that the prior stays invertible."""
@@ -177,6 +233,10 @@ class Params:
     batch: bool = True             # final batch Levenberg-Marquardt
     covariances: bool = True       # compute marginals after the batch pass
     calib_states: bool = False     # estimate the calibration error (constant over the run) as a state
+    calib_model: str = "linear"    # with calib_states, how an observation depends on that error:
+                                   # linear (the log's jac_calib at the nominal calibration) | exact
+                                   # (libcyl's camera model evaluated at the estimate through the cyl
+                                   # binding, residual in the image: calib_factor_exact)
     lm_bias: str = "auto"          # with calib_states, the centroid's residual bias (obs.bias_var_px2):
                                    # state (one (du, dv) px state per landmark shared by all its
                                    # observations, prior from the log's bias_var_px2 of the
@@ -225,13 +285,18 @@ class Slam:
     def _odom_noise(self, cov):
         return gtsam.noiseModel.Gaussian.Covariance(np.asarray(cov, float))
 
-    def _obs_noise(self, cov_rb):
-        g = gtsam.noiseModel.Gaussian.Covariance(to_gtsam_cov(cov_rb))
+    def _robust(self):
+        """The robust kernel observation factors are wrapped in, or None."""
         if self.p.robust in ROBUST_KERNELS:
-            return gtsam.noiseModel.Robust.Create(ROBUST_KERNELS[self.p.robust].Create(self.p.huber_k), g)
+            return ROBUST_KERNELS[self.p.robust].Create(self.p.huber_k)
         if self.p.robust != "none":
             raise ValueError(f"unknown robust kernel {self.p.robust!r}")
-        return g
+        return None
+
+    def _obs_noise(self, cov_rb):
+        g = gtsam.noiseModel.Gaussian.Covariance(to_gtsam_cov(cov_rb))
+        k = self._robust()
+        return g if k is None else gtsam.noiseModel.Robust.Create(k, g)
 
     def _bias_prior(self, o, use_calib):
         """The prior variance (u, v) px^2 of a new landmark's centroid-bias state, or None for no
@@ -283,6 +348,13 @@ class Slam:
             graph.add(f)
             new_f.add(f)
             new_v.insert(CALIB, np.zeros(8))
+        rbm = None
+        if p.calib_model not in ("exact", "linear"):
+            raise ValueError(f"unknown calibration model {p.calib_model!r}")
+        if use_calib and p.calib_model == "exact":
+            rbm, why = range_bearing_model(getattr(ds, "header", None))
+            if rbm is None:
+                raise ValueError(f"--calib-model exact: {why}")
         if p.lm_bias not in ("auto", "none", "state"):
             raise ValueError(f"unknown landmark bias model {p.lm_bias!r}")
         lm_bias = {}                        # landmark -> its bias state's prior variance (u, v) px^2, or None
@@ -294,7 +366,7 @@ class Slam:
         assoc = []
         st = dict(obs_total=0, dropped_flags=0, dropped_no_range=0, dropped_confidence=0, dropped_far=0,
                   dropped_ambiguous=0, dropped_imprecise=0, used=0, new_landmarks=0, isam_updates=0,
-                  marginal_calls=0, association=mode, by_identity=0, bias_states=0)
+                  marginal_calls=0, association=mode, by_identity=0, bias_states=0, exact_factors=0)
         last_update = 0
         gate = chi2_2dof(p.gate_p)
         new_thr = chi2_2dof(p.new_p)
@@ -391,7 +463,14 @@ class Slam:
                         cf = cf - jpx @ np.diag(np.minimum(o.bias_var_px2, lm_bias[j])) @ jpx.T
                     if p.fixed_frame_cov is not None:
                         cf = p.fixed_frame_cov
-                    f = calib_factor(X(i), L(j), o, self._obs_noise(cf), B(j) if lm_bias[j] is not None else None)
+                    bk = B(j) if lm_bias[j] is not None else None
+                    if rbm is not None:
+                        if o.u_px is None:
+                            raise ValueError(f"{o.where}: --calib-model exact needs the observation's u_px, v_px")
+                        f = calib_factor_exact(X(i), L(j), o, cf, rbm, self._robust(), bk)
+                        st["exact_factors"] += 1
+                    else:
+                        f = calib_factor(X(i), L(j), o, self._obs_noise(cf), bk)
                 else:
                     f = gtsam.BearingRangeFactor2D(X(i), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
                                                    self._obs_noise(c))

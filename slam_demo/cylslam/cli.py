@@ -52,6 +52,7 @@ def _params(args, **over):
                anchor=args.anchor, batch=not args.no_batch, reject_flags=int(args.reject_flags, 0),
                calib_states=getattr(args, "calib_states", False),
                lm_bias=getattr(args, "lm_bias", "auto"),
+               calib_model=getattr(args, "calib_model", "linear"),
                max_range_rel_sigma=(None if getattr(args, "max_range_rel_sigma", None) in (None, 0)
                                     else args.max_range_rel_sigma))
     for k, v in over.items():
@@ -353,6 +354,12 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
                         "state for the run: each observation's factor uses its frame covariance and "
                         "calibration Jacobian instead of its full covariance (our logs; "
                         "docs/uncertainty.md)")
+    g.add_argument("--calib-model", choices=["linear", "exact"], default="linear",
+                   help="with --calib-states, how an observation depends on the calibration error: "
+                        "linear (the log's jac_calib at the nominal calibration) or exact (libcyl's camera "
+                        "model evaluated at the estimated calibration through the cyl Python binding, the "
+                        "residual taken in the image; needs the header camera's distortion and u_px, v_px; "
+                        "docs/uncertainty.md, \"Far observations\") (default %(default)s)")
     g.add_argument("--lm-bias", choices=["auto", "state", "none"], default="auto",
                    help="with --calib-states: the centroid's residual bias (the log's bias_var_px2) "
                         "as one state per landmark shared by its observations (state), or as white "

@@ -37,6 +37,8 @@ class Obs:
     cov_frame: Optional[np.ndarray] = None   # 2x2 frame-to-frame covariance (no calibration), or None
     bias_var_px2: Optional[np.ndarray] = None   # (u, v) variance of the centroid's residual bias, px^2,
                                   # a part of cov_frame that does not change from frame to frame
+    u_px: Optional[float] = None  # the measured point range and bearing were computed from, px
+    v_px: Optional[float] = None  # (the camera model's input; None when the source has no pixel)
 
 
 @dataclass

@@ -241,10 +241,13 @@ class _Builder:
                     bv = np.array(_numlist(rec, "bias_var_px2", 2, where))
                     if (bv < 0).any():
                         raise ObsLogError(f"{where}: bias_var_px2 must be >= 0, got {bv.tolist()}")
+            u = v = None
+            if jm is not None and "u_px" in rec:
+                u, v = _num(rec, "u_px", where), _num(rec, "v_px", where)
             fr = self._frame_of(rec, where, "obs")
             fr["obs"].append(Obs(cls=cls, range_m=r, bearing_rad=b, cov=cov, confidence=conf,
                                  flags=flags, lm_id=lm_id, where=where, jac_calib=jm, cov_frame=cf,
-                                 bias_var_px2=bv))
+                                 bias_var_px2=bv, u_px=u, v_px=v))
         elif typ == "odom":
             d = np.array([_num(rec, k, where) for k in ("dx_m", "dy_m", "dtheta_rad")])
             xx, xy, xt, yy, yt, tt = _numlist(rec, "cov", 6, where, " (xx xy xt yy yt tt)")

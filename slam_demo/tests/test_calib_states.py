@@ -136,3 +136,117 @@ def test_fixed_frame_covariance_keeps_the_states_and_replaces_only_the_frame_par
     assert 0.05 < np.degrees(wide.stats["calib_error_estimate"][4]) < 0.6
     moved = [np.min(np.linalg.norm(np.array(main.lms) - l, axis=1)) for l in wide.lms]
     assert len(moved) > 0 and max(moved) > 1e-4
+
+
+# --- the camera model evaluated at the estimated calibration (--calib-model exact) ------------
+
+SYNTH_LENS = dict(k1=-0.12, k2=0.05, p1=0.0008, p2=-0.0006, k3=0.0)   # calib_data/synthetic_camera.yaml
+
+
+def _exact_setup(u=180.0, v=150.0, d_true=None):
+    """An observation of the synthetic camera at pixel (u, v) -- far, 3.2 m -- made with the nominal
+    calibration, a pose, and the landmark where the true calibration (nominal + d_true) puts it."""
+    from cylslam.camera_model import range_bearing_model
+    header = {"model": "exact", "camera": dict(width=640, height=480, fx=570.0, fy=568.0, cx=322.4, cy=236.9,
+                                               tilt_rad=0.20944, yaw_rad=0.0, height_m=0.326, offset_m=0.1,
+                                               **SYNTH_LENS)}
+    rbm, why = range_bearing_model(header)
+    assert rbm is not None, why
+    r0, b0, j0 = rbm.eval(u, v)
+    jac = j0[:, list(rbm.CALIB_INPUTS)]
+    jpx = j0[:, 0:2]
+    cov_px = np.diag([0.01, 0.04])
+    o = Obs(cls="orange", range_m=r0, bearing_rad=b0, cov=np.eye(2), jac_calib=jac,
+            cov_frame=jpx @ cov_px @ jpx.T, u_px=u, v_px=v)
+    pose = np.array([0.4, -0.3, 0.5])
+    d_true = np.zeros(8) if d_true is None else d_true
+    rt, bt, _ = rbm.eval(u, v, d_true)
+    lm = pose[:2] + rt * np.array([np.cos(pose[2] + bt), np.sin(pose[2] + bt)])
+    return rbm, o, pose, lm, cov_px
+
+
+def _values(pose, lm, d, bias=None):
+    from cylslam.backend import B
+    v = gtsam.Values()
+    v.insert(X(0), gtsam.Pose2(*pose))
+    v.insert(L(0), gtsam.Point2(*lm))
+    v.insert(CALIB, np.asarray(d, float))
+    if bias is not None:
+        v.insert(B(0), np.asarray(bias, float))
+    return v
+
+
+def test_exact_factor_is_the_model_at_the_estimate():
+    """Zero residual where the true calibration error is (far beyond the linearisation: the range
+    moves 9 % for a 1 deg tilt error at 3.2 m), a residual for the linear factor there; the noise is
+    the centroid's in px; at the nominal calibration both factors give the same error."""
+    from cylslam.backend import calib_factor_exact
+    d_true = np.array([0.8, -0.6, 0.5, -0.4, np.radians(1.0), np.radians(-0.4), 0.002, -0.003])
+    rbm, o, pose, lm, cov_px = _exact_setup(d_true=d_true)
+    f = calib_factor_exact(X(0), L(0), o, o.cov_frame, rbm)
+    lin = calib_factor(X(0), L(0), o, gtsam.noiseModel.Gaussian.Covariance(o.cov_frame[::-1, ::-1]))
+    assert f.error(_values(pose, lm, d_true)) < 1e-16
+    assert lin.error(_values(pose, lm, d_true)) > 1.0          # the linearisation misses by > 1 sigma
+    # the factor's residual is in px: its noise model is the centroid's covariance
+    assert np.allclose(f.noiseModel().covariance(), cov_px, rtol=1e-9)
+    # at the nominal calibration the two are the same error, wherever pose and landmark are
+    for lm2 in (lm, lm + [0.05, -0.03], lm + [-0.2, 0.1]):
+        a, b = f.error(_values(pose, lm2, np.zeros(8))), lin.error(_values(pose, lm2, np.zeros(8)))
+        assert a == pytest.approx(b, rel=1e-6)
+
+
+def test_exact_factor_jacobians_match_central_differences():
+    """The pose, landmark and bias columns are exact everywhere (the residual's scaling A(delta)^-1
+    does not depend on them); the calibration columns ignore how A(delta)^-1 itself changes -- a
+    Gauss-Newton approximation, exact where the residual is zero, which is checked there."""
+    from cylslam.backend import B, calib_factor_exact
+    d0 = np.array([0.3, -0.2, 0.4, 0.1, np.radians(0.5), np.radians(0.2), 0.001, 0.002])
+    rbm, o, pose, lm, _ = _exact_setup(u=420.0, v=190.0, d_true=d0)
+    f = calib_factor_exact(X(0), L(0), o, o.cov_frame, rbm, bias_key=B(0))
+    moved = dict(pose=pose + [0.01, -0.02, 0.003], lm=lm + [0.03, -0.01], d=d0 * 0.7, b=np.array([0.2, -0.3]))
+    at_zero = dict(pose=pose, lm=lm, d=d0, b=np.zeros(2))
+
+    def jacobians(at):
+        def werr(pose_xi=np.zeros(3), lm_=None, d=None, b=None):
+            p = gtsam.Pose2(*at["pose"]).retract(pose_xi)
+            return f.whitenedError(_values([p.x(), p.y(), p.theta()], at["lm"] if lm_ is None else lm_,
+                                           at["d"] if d is None else d, at["b"] if b is None else b))
+        a, _ = f.linearize(_values(at["pose"], at["lm"], at["d"], at["b"])).jacobian()
+        num = np.hstack([numeric(lambda x: werr(pose_xi=x), np.zeros(3)),
+                         numeric(lambda x: werr(lm_=x), at["lm"]),
+                         numeric(lambda x: werr(d=x), at["d"], eps=1e-7),
+                         numeric(lambda x: werr(b=x), at["b"])])
+        return a, num, np.linalg.norm(werr())
+
+    a, num, r = jacobians(at_zero)
+    assert r < 1e-7
+    assert np.allclose(a, num, rtol=1e-4, atol=1e-5 * np.abs(num).max())
+    a, num, r = jacobians(moved)
+    assert r > 1.0                                   # a real residual: the approximation matters
+    other = np.r_[0:5, 13:15]
+    assert np.allclose(a[:, other], num[:, other], rtol=1e-4, atol=1e-5 * np.abs(num[:, other]).max())
+    calib = np.r_[5:13]
+    assert not np.allclose(a[:, calib], num[:, calib], rtol=1e-4, atol=1e-5 * np.abs(num).max())
+
+
+def test_exact_model_needs_the_lens(tmp_path):
+    """A log without the header's distortion coefficients cannot use the exact model: a clear error;
+    with them (the fixture's camera is calib_data/synthetic_camera.yaml) the run maps as the linear
+    one does on this drive's near observations, and evaluates every used observation exactly."""
+    import json
+    ds = read_obslog(FIX)
+    with pytest.raises(ValueError, match="lacks k1, k2, p1, p2, k3"):
+        Slam(Params(calib_states=True, calib_model="exact", covariances=False)).run(ds)
+    lines = open(FIX).read().splitlines()
+    h = json.loads(lines[0])
+    h["camera"].update(SYNTH_LENS)
+    p = tmp_path / "lens.jsonl"
+    p.write_text("\n".join([json.dumps(h)] + lines[1:]) + "\n")
+    ds = read_obslog(str(p))
+    lin = Slam(Params(calib_states=True, covariances=False)).run(ds)
+    ex = Slam(Params(calib_states=True, calib_model="exact", covariances=False)).run(ds)
+    assert ex.stats["exact_factors"] == ex.stats["used"] > 100
+    assert lin.stats["exact_factors"] == 0
+    assert len(ex.lms) == len(lin.lms)
+    assert abs(np.degrees(ex.stats["calib_error_estimate"][4] - lin.stats["calib_error_estimate"][4])) < 0.05
+    assert np.max(np.abs(np.array(ex.lms) - np.array(lin.lms))) < 0.01
