@@ -26,10 +26,14 @@ and its largest planar standard deviation is <= init_max_sigma (0.5 m: a near-ho
 range sigma of metres must not seed a landmark; it may still update one); otherwise it is dropped
 (ambiguous / imprecise, counted). The candidate radius is cand_radius + 3 sigma of the
 observation, keeping the `max_cands` (4) nearest. Known association (`assoc="known"`) uses the identities in
-the data instead.
+the data instead. Options (off by default; slam_demo/README.md has their measured effect): `joint`
+replaces the Hungarian assignment by joint compatibility branch and bound (`_jcbb`), `exclusion`
+lets an observation whose compatible landmarks are all taken in its frame start a landmark, and
+`merge_every` merges duplicates (`_merge`).
 """
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass, field
@@ -56,6 +60,14 @@ def L(j):
 def to_gtsam_cov(cov_rb):
     """(range, bearing) covariance -> GTSAM's (bearing, range) order."""
     return PERM @ np.asarray(cov_rb, float) @ PERM
+
+
+@functools.lru_cache(maxsize=256)
+def chi2_2k(p, k):
+    """Chi-square quantile for 2k degrees of freedom at probability p (the joint gate of k
+    pairings), by scipy."""
+    from scipy.stats import chi2
+    return float(chi2.ppf(p, 2 * k))
 
 
 def chi2_2dof(p):
@@ -218,6 +230,13 @@ class Params:
     cand_radius: float = 2.0       # m, Euclidean pre-selection of candidates (+ 3 sigma of the obs)
     init_max_sigma: float = 0.5    # m, no new landmark from an observation less precise than this
     max_cands: int = 4             # at most this many nearest candidates per observation
+    exclusion: bool = False        # an unassigned observation whose every compatible landmark is
+                                   # taken by another observation of its frame starts a landmark
+    joint: bool = False            # unknown association: joint compatibility (JCBB) instead of
+                                   # the Hungarian assignment of individual distances
+    merge_every: int = 0           # unknown association: every N steps, two landmarks of a class
+                                   # never seen in one frame whose difference is inside the gate
+                                   # (joint marginal) become one; 0: never
     reject_flags: int = FLAGS_REJECT  # obs.flags bits that drop an observation (format: 0x320)
     max_range_rel_sigma: Optional[float] = None  # drop an observation whose range sigma exceeds this
                                    # times its range (its range is then far from Gaussian); None: keep
@@ -257,6 +276,7 @@ class Result:
     assoc: list                           # (step index, Obs, landmark index) per used observation
     stats: dict = field(default_factory=dict)
     info: Optional["Information"] = None  # the information matrix at the estimate (joint NEES)
+    lm_keys: Optional[list] = None        # the graph key of each landmark (L(j) when None)
 
 
 def drop_reason(o, p):
@@ -366,8 +386,10 @@ class Slam:
         assoc = []
         st = dict(obs_total=0, dropped_flags=0, dropped_no_range=0, dropped_confidence=0, dropped_far=0,
                   dropped_ambiguous=0, dropped_imprecise=0, used=0, new_landmarks=0, isam_updates=0,
-                  marginal_calls=0, association=mode, by_identity=0, bias_states=0, exact_factors=0)
+                  marginal_calls=0, new_by_exclusion=0, association=mode, by_identity=0, bias_states=0, exact_factors=0)
         last_update = 0
+        merged_into = {}                    # landmark -> the landmark it was merged into
+        co_seen = set()                     # (j, k), j < k: landmarks observed in one frame
         gate = chi2_2dof(p.gate_p)
         new_thr = chi2_2dof(p.new_p)
         for i, s in enumerate(steps):
@@ -399,6 +421,16 @@ class Slam:
                 last_update = i
                 e = isam.calculateEstimatePose2(X(i))
                 cur = np.array([e.x(), e.y(), e.theta()])
+                if mode == "unknown" and p.merge_every and i % p.merge_every == 0 and i:
+                    ties = gtsam.NonlinearFactorGraph()
+                    for f in self._merge(isam, by_class, merged_into, co_seen, gate, st):
+                        graph.add(f)
+                        ties.add(f)
+                    if ties.size():          # at once: this frame is associated on the merged map
+                        isam.update(ties, gtsam.Values())
+                        st["isam_updates"] += 1
+                        e = isam.calculateEstimatePose2(X(i))
+                        cur = np.array([e.x(), e.y(), e.theta()])
             if not usable:
                 if self.on_step:
                     self.on_step(i, s.seq, s.t, cur, [], isam, lms_init)
@@ -478,6 +510,8 @@ class Slam:
                 new_f.add(f)
                 assoc.append((i, o, j))
                 st["used"] += 1
+            seen = sorted({j for (k, o, j) in assoc[-len(usable):] if k == i})
+            co_seen.update((a, b) for x, a in enumerate(seen) for b in seen[x + 1:])
             if self.on_step:
                 self.on_step(i, s.seq, s.t, cur, [(o, j) for (k, o, j) in assoc[-len(usable):] if k == i],
                              isam, lms_init)
@@ -486,6 +520,7 @@ class Slam:
             st["isam_updates"] += 1
         est = isam.calculateEstimate()
         t_isam = time.perf_counter() - t0
+        st["merged_landmarks"] = len(merged_into)
         isam_poses = _poses(est, n)
         if p.batch:
             lp = gtsam.LevenbergMarquardtParams()
@@ -495,13 +530,21 @@ class Slam:
             st["batch_iterations"] = opt.iterations()
         t_batch = time.perf_counter() - t0 - t_isam
         poses = _poses(est, n)
-        m = len(lms_init)
-        lms = np.array([[est.atPoint2(L(j))[0], est.atPoint2(L(j))[1]] for j in range(m)]).reshape(m, 2)
+        # a merged landmark is the one it was merged into: results list each once
+        keep = [j for j in range(len(lms_init)) if j not in merged_into]
+        index = {j: x for x, j in enumerate(keep)}
+        root = {j: index[_root(merged_into, j)] for j in range(len(lms_init))}
+        assoc = [(i, o, root[j]) for (i, o, j) in assoc]
+        lm_class = [lm_class[j] for j in keep]
+        lm_ids = [lm_ids[j] for j in keep]
+        lm_keys = [L(j) for j in keep]
+        m = len(keep)
+        lms = np.array([[est.atPoint2(k)[0], est.atPoint2(k)[1]] for k in lm_keys]).reshape(m, 2)
         pose_cov = lm_cov = info = None
         if p.covariances:
             marg = gtsam.Marginals(graph, est)
             pose_cov = np.array([marg.marginalCovariance(X(i)) for i in range(n)])
-            lm_cov = np.array([marg.marginalCovariance(L(j)) for j in range(m)]).reshape(m, 2, 2)
+            lm_cov = np.array([marg.marginalCovariance(k) for k in lm_keys]).reshape(m, 2, 2)
             # Poses share every earlier odometry step, and landmarks the poses and the calibration:
             # their errors are correlated, and only the joint covariance whitens them together. Its
             # inverse over any set of variables is a Schur complement of the sparse information
@@ -517,7 +560,106 @@ class Slam:
             st["calib_error_estimate"] = [float(x) for x in est.atVector(CALIB)]
         return Result(poses=poses, pose_cov=pose_cov, isam_poses=isam_poses, lms=lms,
                       lm_cov=lm_cov, lm_class=lm_class, lm_ids=lm_ids, assoc=assoc, stats=st,
-                      info=info)
+                      info=info, lm_keys=lm_keys)
+
+    def _jcbb(self, xkey, usable, zs, covs, cands, d2s, allc, lm_est, cur, jm, gate, ncand):
+        """Joint compatibility branch and bound (Neira and Tardos 2001): among the hypotheses that
+        pair each observation with an individually compatible candidate (d2 <= gate) or with none,
+        at most one observation per landmark, the one with the most pairings whose joint innovation
+        is compatible (NIS <= chi2_2k(gate_p), with the current pose's and the landmarks' joint
+        covariance: the pose error, common to all pairings, is counted once), the lowest NIS among
+        equals. Returns the column per observation as the Hungarian does (c < ncand: candidate c)."""
+        col = {j: k for k, j in enumerate(allc)}
+        dim = 3 + 2 * len(allc)
+        Sig = np.zeros((dim, dim))
+        blocks = [("x", None)] + [("l", j) for j in allc]
+
+        def key(b):
+            return xkey if b[0] == "x" else L(b[1])
+        off = [0] + [3 + 2 * k for k in range(len(allc))]
+        sz = [3] + [2] * len(allc)
+        for a_, ba in enumerate(blocks):
+            for b_, bb in enumerate(blocks):
+                Sig[off[a_]:off[a_] + sz[a_], off[b_]:off[b_] + sz[b_]] = jm.at(key(ba), key(bb))
+        pre = {}
+        for a, cs in enumerate(cands):
+            for j in cs:
+                if d2s[a].get(j, np.inf) <= gate:
+                    h, H = predict_rb(cur, lm_est[j])
+                    nu = zs[a] - h
+                    nu[1] = wrap(nu[1])
+                    Hrow = np.zeros((2, dim))
+                    Hrow[:, 0:3] = H[:, 0:3]
+                    c = 3 + 2 * col[j]
+                    Hrow[:, c:c + 2] = H[:, 3:5]
+                    pre[a, j] = (nu, Hrow)
+        nobs = len(usable)
+        best = {"n": 0, "nis": 0.0, "h": [None] * nobs}
+
+        def nis(hyp):
+            pairs = [(a, j) for a, j in enumerate(hyp) if j is not None]
+            if not pairs:
+                return 0.0
+            nu = np.concatenate([pre[p][0] for p in pairs])
+            Hm = np.vstack([pre[p][1] for p in pairs])
+            S = Hm @ Sig @ Hm.T
+            for k, (a, _) in enumerate(pairs):
+                S[2 * k:2 * k + 2, 2 * k:2 * k + 2] += covs[a]
+            return float(nu @ np.linalg.solve(S, nu))
+
+        def dfs(a, hyp, npair, used):
+            if a == nobs:
+                d2 = nis(hyp)
+                if npair > best["n"] or (npair == best["n"] and d2 < best["nis"]):
+                    best.update(n=npair, nis=d2, h=list(hyp))
+                return
+            if npair + (nobs - a) < best["n"]:
+                return                                   # cannot beat the best any more
+            for j in cands[a]:
+                if (a, j) in pre and j not in used:
+                    hyp[a] = j
+                    if nis(hyp) <= chi2_2k(self.p.gate_p, npair + 1):
+                        dfs(a + 1, hyp, npair + 1, used | {j})
+                    hyp[a] = None
+            dfs(a + 1, hyp, npair, used)
+
+        dfs(0, [None] * nobs, 0, frozenset())
+        return [col[j] if j is not None else ncand + a for a, j in enumerate(best["h"])]
+
+    def _merge(self, isam, by_class, merged_into, co_seen, gate, st):
+        """Duplicate landmarks: two of a class, never observed in one frame, within cand_radius + 3
+        sigma of each other, whose difference is inside the association gate under their joint marginal
+        covariance. The younger is tied to the older by a Point2 equality factor (sigma 1 mm) and
+        leaves the association candidates; its observations count as the older's. Returns the new
+        factors."""
+        out = []
+        noise = gtsam.noiseModel.Isotropic.Sigma(2, 1e-3)
+        for cls, js in by_class.items():
+            for x, j in enumerate(js):
+                if j in merged_into:
+                    continue
+                for k in js[x + 1:]:
+                    if k in merged_into or j in merged_into or (min(j, k), max(j, k)) in co_seen:
+                        continue
+                    pj = isam.calculateEstimatePoint2(L(j))
+                    pk = isam.calculateEstimatePoint2(L(k))
+                    dlt = np.array([pk[0] - pj[0], pk[1] - pj[1]])
+                    spread = sum(math.sqrt(np.trace(isam.marginalCovariance(L(x)))) for x in (j, k))
+                    if math.hypot(*dlt) > self.p.cand_radius + 3.0 * spread:
+                        continue
+                    jm = isam.jointMarginalCovariance([L(j), L(k)])
+                    st["marginal_calls"] += 1
+                    S = jm.at(L(j), L(j)) + jm.at(L(k), L(k)) - jm.at(L(j), L(k)) - jm.at(L(k), L(j))
+                    if float(dlt @ np.linalg.solve(S, dlt)) > gate:
+                        continue
+                    merged_into[k] = j
+                    for a, b in list(co_seen):
+                        if k in (a, b):
+                            o = b if a == k else a
+                            co_seen.add((min(o, j), max(o, j)))
+                    out.append(gtsam.BetweenFactorPoint2(L(j), L(k), gtsam.Point2(0.0, 0.0), noise))
+            by_class[cls] = [j for j in js if j not in merged_into]
+        return out
 
     def _associate(self, isam, i, cur, usable, covs, lms_init, lm_class, by_class, gate,
                    new_thr, st):
@@ -557,7 +699,7 @@ class Slam:
         nobs, ncand = len(usable), len(allc)
         BIG = 1e9
         cost = np.full((nobs, ncand + nobs), BIG)
-        d2min = np.full(nobs, np.inf)
+        d2s = [dict() for _ in range(nobs)]
         for a, (o, z, cs) in enumerate(zip(usable, zs, cands)):
             R = covs[a]
             for j in cs:
@@ -568,22 +710,40 @@ class Slam:
                 nu = z - h
                 nu[1] = wrap(nu[1])
                 d2 = float(nu @ np.linalg.solve(S, nu))
-                d2min[a] = min(d2min[a], d2)
+                d2s[a][j] = d2
                 if d2 <= gate:
                     cost[a, col[j]] = d2
             cost[a, ncand + a] = gate
-        sol = hungarian(cost)
+        if self.p.joint:
+            sol = self._jcbb(X(i), usable, zs, covs, cands, d2s, allc, lm_est, cur, jm, gate, ncand)
+        else:
+            sol = hungarian(cost)
+        taken = {allc[c] for a, c in enumerate(sol) if c < ncand and cost[a, c] < BIG}
         out = []
         for a, c in enumerate(sol):
             if c < ncand and cost[a, c] < BIG:
                 out.append(allc[c])
-            elif d2min[a] <= new_thr:
+                continue
+            near = [j for j in cands[a] if d2s[a].get(j, np.inf) <= new_thr]
+            # A landmark gives at most one observation a frame: when every landmark this one might be
+            # is taken by another observation of the same frame, it is a landmark not yet mapped
+            # (posts closer together than the range noise), not an ambiguous one.
+            exclusive = self.p.exclusion and all(j in taken for j in near)
+            if near and not exclusive:
                 out.append(-3)
             elif sig[a] > self.p.init_max_sigma:
                 out.append(-4)
             else:
                 out.append(-1)
+                if near:
+                    st["new_by_exclusion"] += 1
         return out
+
+
+def _root(merged_into, j):
+    while j in merged_into:
+        j = merged_into[j]
+    return j
 
 
 class Information:

@@ -50,6 +50,8 @@ def _params(args, **over):
     p = Params(assoc=args.assoc, conf_min=args.conf_min, gate_p=args.gate, new_p=args.new_gate,
                cand_radius=args.cand_radius, init_max_sigma=args.init_max_sigma, robust=args.robust, huber_k=args.huber_k,
                anchor=args.anchor, batch=not args.no_batch, reject_flags=int(args.reject_flags, 0),
+               exclusion=getattr(args, "exclusion", False), joint=getattr(args, "assoc_method", "") == "jcbb",
+               merge_every=getattr(args, "merge_every", 0),
                calib_states=getattr(args, "calib_states", False),
                lm_bias=getattr(args, "lm_bias", "auto"),
                calib_model=getattr(args, "calib_model", "linear"),
@@ -325,6 +327,17 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
     g.add_argument("--new-gate", type=float, default=0.9999,
                    help="new landmark only if beyond this chi-square probability of every "
                         "landmark; between --gate and this: dropped as ambiguous (default %(default)s)")
+    g.add_argument("--assoc-method", choices=["hungarian", "jcbb"], default="hungarian",
+                   help="unknown association: the assignment of least total distance among "
+                        "individually gated pairs, or joint compatibility branch and bound (the most "
+                        "pairings whose joint innovation passes the gate) (default %(default)s)")
+    g.add_argument("--exclusion", action="store_true",
+                   help="unknown association: an observation whose compatible landmarks are all "
+                        "taken by other observations of its frame starts a landmark (one landmark "
+                        "gives one observation a frame) instead of being dropped as ambiguous")
+    g.add_argument("--merge-every", type=int, default=0, metavar="N",
+                   help="unknown association: every N steps, merge two landmarks of a class never "
+                        "seen in one frame whose difference passes the gate (default 0: never)")
     g.add_argument("--cand-radius", type=float, default=2.0,
                    help="m, Euclidean pre-selection of association candidates, plus 3 sigma of "
                         "the observation (default %(default)s)")

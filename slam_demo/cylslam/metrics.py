@@ -220,7 +220,8 @@ def evaluate(ds, res):
                 if res.info is not None:
                     from .backend import L
                     e = (est - tr).reshape(-1)
-                    out["anees_landmarks_joint"] = res.info.nees([L(j) for j in js], e) / len(e)
+                    keys = res.lm_keys or [L(j) for j in range(len(res.lms))]
+                    out["anees_landmarks_joint"] = res.info.nees([keys[j] for j in js], e) / len(e)
                     out["anees_landmarks_joint_bounds95"] = list(anees_bounds(len(e), 1))
         out["_match"] = mp
     return out

@@ -1,0 +1,255 @@
+# SPDX-License-Identifier: BSD-3-Clause
+"""Unknown association's options: one landmark gives one observation a frame (--exclusion), joint
+compatibility (--assoc-method jcbb) and the merging of duplicates (--merge-every)."""
+import itertools
+
+import gtsam
+import numpy as np
+import pytest
+
+from cylslam import backend, metrics
+from cylslam.backend import L, X
+from cylslam.data import Dataset, Obs, Step, wrap
+
+
+def _obs(pose, lm, cov):
+    h, _ = backend.predict_rb(pose, lm)
+    return Obs(cls="post", range_m=float(h[0]), bearing_rad=float(h[1]), cov=cov, confidence=1.0)
+
+
+def _cluster_drive():
+    """Two posts 0.2 m apart at 3 m, observed with a range sigma of 0.15 m and a bearing sigma of
+    0.04 rad (0.12 m across at 3 m): each post lies well inside the other's gate. Frame 0 sees post
+    A alone; frames 1-3 see both."""
+    A, B = np.array([3.0, 0.1]), np.array([3.0, -0.1])
+    cov = np.diag([0.15 ** 2, 0.04 ** 2])
+    steps = [Step(t=0, seq=0, truth=np.zeros(3), obs=[_obs(np.zeros(3), A, cov)])]
+    pose = np.zeros(3)
+    for k in range(1, 4):
+        pose = pose + [0.05, 0.0, 0.0]
+        steps.append(Step(t=k, seq=k, odom=np.array([0.05, 0.0, 0.0]), odom_cov=np.diag([1e-6] * 3),
+                          truth=pose.copy(), obs=[_obs(pose, A, cov), _obs(pose, B, cov)]))
+    return Dataset(name="cluster", steps=steps, truth_landmarks={0: (*A, "post"), 1: (*B, "post")})
+
+
+def test_exclusion_maps_both_posts_of_a_cluster():
+    """Without exclusion the second post's observation, inside A's gate but not taken by it, is
+    dropped as ambiguous frame after frame and B is never mapped; with it, an observation whose every
+    compatible landmark is taken in its frame starts B, and both posts are mapped without error."""
+    ds = _cluster_drive()
+    old = backend.Slam(backend.Params(assoc="unknown")).run(ds)
+    assert len(old.lms) == 1 and old.stats["dropped_ambiguous"] == 3
+    new = backend.Slam(backend.Params(assoc="unknown", exclusion=True)).run(ds)
+    assert len(new.lms) == 2 and new.stats["dropped_ambiguous"] == 0
+    assert new.stats["new_by_exclusion"] == 1
+    assert metrics.evaluate(ds, new)["association_errors"] == 0
+    assert np.allclose(sorted(new.lms[:, 1]), [-0.1, 0.1], atol=0.02)
+
+
+class _JointMarginal:
+    """Stands in for gtsam's JointMarginal: blocks of a dense covariance by key."""
+
+    def __init__(self, keys, dims, cov):
+        self.off, o = {}, 0
+        for k, d in zip(keys, dims):
+            self.off[k] = (o, d)
+            o += d
+        self.cov = cov
+
+    def at(self, a, b):
+        (i, m), (j, n) = self.off[a], self.off[b]
+        return self.cov[i:i + m, j:j + n]
+
+
+def _problem(cur, lms, zs, R, sig_pose, sig_lm):
+    allc = list(range(len(lms)))
+    dim = 3 + 2 * len(lms)
+    cov = np.zeros((dim, dim))
+    cov[:3, :3] = np.diag(np.square(sig_pose))
+    cov[3:, 3:] = np.eye(2 * len(lms)) * sig_lm ** 2
+    jm = _JointMarginal([X(0)] + [L(j) for j in allc], [3] + [2] * len(lms), cov)
+    gate = backend.chi2_2dof(0.99)
+    d2s = []
+    for z in zs:
+        d = {}
+        for j in allc:
+            h, H = backend.predict_rb(cur, lms[j])
+            Sg = np.zeros((5, 5))
+            Sg[:3, :3], Sg[3:, 3:] = cov[:3, :3], cov[3 + 2 * j:5 + 2 * j, 3 + 2 * j:5 + 2 * j]
+            nu = z - h
+            nu[1] = wrap(nu[1])
+            d[j] = float(nu @ np.linalg.solve(H @ Sg @ H.T + R, nu))
+        d2s.append(d)
+    usable = [None] * len(zs)
+    cands = [allc for _ in zs]
+    lm_est = {j: np.asarray(lms[j], float) for j in allc}
+    return dict(xkey=X(0), usable=usable, zs=[np.asarray(z, float) for z in zs], covs=[R] * len(zs),
+                cands=cands, d2s=d2s, allc=allc, lm_est=lm_est, cur=cur, jm=jm, gate=gate,
+                ncand=len(allc)), cov
+
+
+def _joint_nis(pb, cov, hyp):
+    pairs = [(a, j) for a, j in enumerate(hyp) if j is not None]
+    nus, Hs = [], []
+    for a, j in pairs:
+        h, H = backend.predict_rb(pb["cur"], pb["lm_est"][j])
+        Hr = np.zeros((2, cov.shape[0]))
+        Hr[:, :3] = H[:, :3]
+        Hr[:, 3 + 2 * j:5 + 2 * j] = H[:, 3:]
+        nu = pb["zs"][a] - h
+        nu[1] = wrap(nu[1])
+        nus.append(nu)
+        Hs.append(Hr)
+    if not pairs:
+        return 0.0
+    nu, Hm = np.concatenate(nus), np.vstack(Hs)
+    S = Hm @ cov @ Hm.T + np.kron(np.eye(len(pairs)), pb["covs"][0])
+    return float(nu @ np.linalg.solve(S, nu))
+
+
+def _brute_force(pb, cov, p=0.99):
+    """Every hypothesis (each observation to a distinct individually gated landmark or none) whose
+    pairings, added in observation order, pass the joint gate at each step; the most pairings, then
+    the least joint NIS."""
+    n = len(pb["zs"])
+    opts = [[None] + [j for j in pb["allc"] if pb["d2s"][a][j] <= pb["gate"]] for a in range(n)]
+    best = None
+    for hyp in itertools.product(*opts):
+        js = [j for j in hyp if j is not None]
+        if len(js) != len(set(js)):
+            continue
+        ok, k = True, 0
+        for a in range(n):
+            if hyp[a] is not None:
+                k += 1
+                pre = list(hyp[:a + 1]) + [None] * (n - a - 1)
+                ok = ok and _joint_nis(pb, cov, pre) <= backend.chi2_2k(p, k)
+        if not ok:
+            continue
+        key = (-len(js), _joint_nis(pb, cov, hyp))
+        if best is None or key < best[0]:
+            best = (key, hyp)
+    return best[1]
+
+
+def test_jcbb_matches_brute_force():
+    rng = np.random.default_rng(11)
+    slam = backend.Slam(backend.Params(assoc="unknown", joint=True))
+    checked = 0
+    for _ in range(40):
+        m, n = int(rng.integers(2, 5)), int(rng.integers(1, 4))
+        lms = [np.array([3.0, 0.0]) + rng.normal(0, 0.3, 2) for _ in range(m)]
+        cur = np.array([0.0, 0.0, rng.normal(0, 0.02)])
+        R = np.diag([0.1 ** 2, 0.03 ** 2])
+        zs = []
+        for _ in range(n):
+            h, _ = backend.predict_rb(np.zeros(3), lms[int(rng.integers(m))])
+            zs.append(h + rng.normal(0, [0.1, 0.03]))
+        pb, cov = _problem(cur, lms, zs, R, [0.05, 0.05, 0.05], 0.1)
+        got = slam._jcbb(**pb)
+        want = _brute_force(pb, cov)
+        got_j = [pb["allc"][c] if c < pb["ncand"] else None for c in got]
+        assert _joint_nis(pb, cov, got_j) == pytest.approx(_joint_nis(pb, cov, want), rel=1e-9, abs=1e-12)
+        assert sum(j is not None for j in got_j) == sum(j is not None for j in want)
+        checked += sum(j is not None for j in want) >= 2
+    assert checked >= 10      # enough cases with two or more pairings
+
+
+def test_jcbb_rejects_pairings_one_heading_cannot_explain():
+    """The heading is uncertain (0.1 rad), the landmarks well known. Two observations, one turned
+    +0.08 rad from landmark A, the other -0.08 rad from B: each alone is inside its gate (the heading
+    could be off by 0.08), both together are not (one heading error turns both the same way). The
+    Hungarian assignment takes both; joint compatibility keeps one."""
+    A, B = np.array([3.0, 0.6]), np.array([3.0, -0.6])
+    R = np.diag([0.02 ** 2, 0.005 ** 2])
+    za = backend.predict_rb(np.zeros(3), A)[0] + [0.0, 0.08]
+    zb = backend.predict_rb(np.zeros(3), B)[0] + [0.0, -0.08]
+    pb, cov = _problem(np.zeros(3), [A, B], [za, zb], R, [0.01, 0.01, 0.1], 0.01)
+    assert pb["d2s"][0][0] < pb["gate"] and pb["d2s"][1][1] < pb["gate"]
+    assert _joint_nis(pb, cov, [0, 1]) > backend.chi2_2k(0.99, 2)
+    slam = backend.Slam(backend.Params(assoc="unknown", joint=True))
+    got = slam._jcbb(**pb)
+    assert sum(c < pb["ncand"] for c in got) == 1
+    cost = np.full((2, 4), 1e9)
+    for a in range(2):
+        for j in range(2):
+            if pb["d2s"][a][j] <= pb["gate"]:
+                cost[a, j] = pb["d2s"][a][j]
+        cost[a, 2 + a] = pb["gate"]
+    assert backend.hungarian(cost) == [0, 1]
+
+
+def _two_landmarks(offset, sigma):
+    """An iSAM2 with one pose and two landmarks of a class, each seen once from it, `offset` m
+    apart, range and bearing sigmas `sigma` (m, rad/3)."""
+    isam = gtsam.ISAM2()
+    g, v = gtsam.NonlinearFactorGraph(), gtsam.Values()
+    g.add(gtsam.PriorFactorPose2(X(0), gtsam.Pose2(), gtsam.noiseModel.Diagonal.Sigmas(np.array([1e-3, 1e-3, 1e-4]))))
+    v.insert(X(0), gtsam.Pose2())
+    noise = gtsam.noiseModel.Diagonal.Sigmas(np.array([sigma / 3, sigma]))
+    for j, y in enumerate((0.0, offset)):
+        p = np.array([3.0, y])
+        h, _ = backend.predict_rb(np.zeros(3), p)
+        g.add(gtsam.BearingRangeFactor2D(X(0), L(j), gtsam.Rot2(h[1]), h[0], noise))
+        v.insert(L(j), gtsam.Point2(*p))
+    isam.update(g, v)
+    return isam
+
+
+@pytest.mark.parametrize("offset,sigma,co_seen,merged", [
+    (0.05, 0.1, set(), True),           # inside the gate, never seen together: one landmark
+    (0.05, 0.1, {(0, 1)}, False),        # seen in one frame: two landmarks, however close
+    (0.6, 0.1, set(), False),            # 0.6 m apart with 0.1 m sigmas: two landmarks
+])
+def test_merge_of_duplicates(offset, sigma, co_seen, merged):
+    isam = _two_landmarks(offset, sigma)
+    slam = backend.Slam(backend.Params(assoc="unknown", merge_every=1))
+    by_class, merged_into, st = {"post": [0, 1]}, {}, {"marginal_calls": 0}
+    fs = slam._merge(isam, by_class, merged_into, set(co_seen), backend.chi2_2dof(0.99), st)
+    assert (merged_into == {1: 0}) == merged
+    assert len(fs) == int(merged) and by_class["post"] == ([0] if merged else [0, 1])
+    if merged:          # the factor ties the two: after it, one point
+        g = gtsam.NonlinearFactorGraph()
+        g.add(fs[0])
+        isam.update(g, gtsam.Values())
+        a, b = isam.calculateEstimatePoint2(L(0)), isam.calculateEstimatePoint2(L(1))
+        assert np.linalg.norm(np.asarray(a) - np.asarray(b)) < 0.005
+
+
+def test_exclusion_leaves_an_observation_ambiguous_while_its_landmark_is_free():
+    """Beyond A's association gate but inside its new-landmark gate, with A taken by no other
+    observation of the frame: nothing says this is another landmark, and it stays dropped."""
+    A = np.array([3.0, 0.1])
+    cov = np.diag([0.15 ** 2, 0.04 ** 2])
+    p1 = np.array([0.05, 0.0, 0.0])
+    z = _obs(p1, A, cov)
+    z.range_m += 0.76                                 # d2 about 13: between chi2_2(0.99) and chi2_2(0.9999)
+    ds = Dataset(name="free", steps=[
+        Step(t=0, seq=0, truth=np.zeros(3), obs=[_obs(np.zeros(3), A, cov)]),
+        Step(t=1, seq=1, odom=p1.copy(), odom_cov=np.diag([1e-6] * 3), truth=p1, obs=[z])])
+    res = backend.Slam(backend.Params(assoc="unknown", exclusion=True)).run(ds)
+    assert len(res.lms) == 1 and res.stats["dropped_ambiguous"] == 1 and res.stats["new_by_exclusion"] == 0
+
+
+def test_a_duplicate_is_merged_and_reported_once():
+    """The odometry claims 0.3 m (sigma 0.3 m) that the robot did not drive; with a candidate radius
+    of 5 cm the next view of A is no candidate and starts a second landmark. Its difference from the
+    first is inside the gate and the two were never seen in one frame: merged, the run reports one
+    landmark, every observation on it, and the equality pulls the pose back to where it was."""
+    A = np.array([3.0, 0.0])
+    cov = np.diag([0.01 ** 2, 0.003 ** 2])
+    z = _obs(np.zeros(3), A, cov)
+    steps = [Step(t=0, seq=0, truth=np.zeros(3), obs=[z]),
+             Step(t=1, seq=1, odom=np.array([0.3, 0.0, 0.0]), odom_cov=np.diag([0.3 ** 2, 1e-6, 1e-6]),
+                  truth=np.zeros(3), obs=[_obs(np.zeros(3), A, cov)]),
+             Step(t=2, seq=2, odom=np.zeros(3), odom_cov=np.diag([1e-6] * 3), truth=np.zeros(3),
+                  obs=[_obs(np.zeros(3), A, cov)])]
+    ds = Dataset(name="duplicate", steps=steps, truth_landmarks={0: (*A, "post")})
+    kept = backend.Slam(backend.Params(assoc="unknown", cand_radius=0.05)).run(ds)
+    assert len(kept.lms) == 2
+    res = backend.Slam(backend.Params(assoc="unknown", cand_radius=0.05, merge_every=1)).run(ds)
+    assert res.stats["merged_landmarks"] == 1 and res.stats["new_landmarks"] == 2
+    assert len(res.lms) == 1 and res.lm_keys == [L(0)] and [j for (_, _, j) in res.assoc] == [0, 0, 0]
+    assert np.allclose(res.lms[0], A, atol=1e-3) and np.allclose(res.poses[:, 0], 0.0, atol=2e-3)
+    m = metrics.evaluate(ds, res)
+    assert m["association_errors"] == 0 and m["anees_landmarks_joint"] is not None
