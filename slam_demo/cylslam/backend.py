@@ -234,6 +234,10 @@ class Params:
                                    # taken by another observation of its frame starts a landmark
     joint: bool = False            # unknown association: joint compatibility (JCBB) instead of
                                    # the Hungarian assignment of individual distances
+    init_views: int = 1            # unknown association: a landmark starts once this many views
+                                   # (from distinct steps) agree; until then they wait in a
+                                   # candidate buffer (1: at once)
+    init_window: int = 50          # steps a candidate waits for its next view before it is dropped
     merge_every: int = 0           # unknown association: every N steps, two landmarks of a class
                                    # never seen in one frame whose difference is inside the gate
                                    # (joint marginal) become one; 0: never
@@ -386,9 +390,10 @@ class Slam:
         assoc = []
         st = dict(obs_total=0, dropped_flags=0, dropped_no_range=0, dropped_confidence=0, dropped_far=0,
                   dropped_ambiguous=0, dropped_imprecise=0, used=0, new_landmarks=0, isam_updates=0,
-                  marginal_calls=0, new_by_exclusion=0, association=mode, by_identity=0, bias_states=0, exact_factors=0)
+                  marginal_calls=0, new_by_exclusion=0, dropped_unconfirmed=0, association=mode, by_identity=0, bias_states=0, exact_factors=0)
         last_update = 0
         merged_into = {}                    # landmark -> the landmark it was merged into
+        pending = CandidateBuffer(p.init_views, p.init_window, chi2_2dof(p.gate_p))
         co_seen = set()                     # (j, k), j < k: landmarks observed in one frame
         gate = chi2_2dof(p.gate_p)
         new_thr = chi2_2dof(p.new_p)
@@ -456,34 +461,29 @@ class Slam:
             else:
                 targets = self._associate(isam, i, cur, usable, covs, lms_init, lm_class,
                                           by_class, gate, new_thr, st)
-            for o, c, j in zip(usable, covs, targets):
-                if j == -3:
-                    st["dropped_ambiguous"] += 1
-                    continue
-                if j == -4:
-                    st["dropped_imprecise"] += 1
-                    continue
-                if mode == "known" or (mode == "mixed" and o.lm_id is not None):
-                    j = id_to_lm.get(o.lm_id, -1)   # may have been created earlier this frame
-                if j == -1:
-                    j = len(lms_init)
-                    pos = rb_to_world(cur, o.range_m, o.bearing_rad)
-                    lms_init.append(pos)
-                    lm_class.append(o.cls)
-                    lm_ids.append(o.lm_id)
-                    by_class.setdefault(o.cls, []).append(j)
-                    if o.lm_id is not None and mode in ("known", "mixed"):
-                        id_to_lm[o.lm_id] = j
-                    new_v.insert(L(j), gtsam.Point2(*pos))
-                    var = self._bias_prior(o, use_calib)
-                    lm_bias[j] = var
-                    if var is not None:
-                        new_v.insert(B(j), np.zeros(2))
-                        f = gtsam.PriorFactorVector(B(j), np.zeros(2), gtsam.noiseModel.Diagonal.Variances(var))
-                        graph.add(f)
-                        new_f.add(f)
-                        st["bias_states"] += 1
-                    st["new_landmarks"] += 1
+            here = []                       # (observation, landmark) used at this step
+
+            def new_landmark(o, pos):
+                j = len(lms_init)
+                lms_init.append(np.asarray(pos, float))
+                lm_class.append(o.cls)
+                lm_ids.append(o.lm_id)
+                by_class.setdefault(o.cls, []).append(j)
+                if o.lm_id is not None and mode in ("known", "mixed"):
+                    id_to_lm[o.lm_id] = j
+                new_v.insert(L(j), gtsam.Point2(*pos))
+                var = self._bias_prior(o, use_calib)
+                lm_bias[j] = var
+                if var is not None:
+                    new_v.insert(B(j), np.zeros(2))
+                    f = gtsam.PriorFactorVector(B(j), np.zeros(2), gtsam.noiseModel.Diagonal.Variances(var))
+                    graph.add(f)
+                    new_f.add(f)
+                    st["bias_states"] += 1
+                st["new_landmarks"] += 1
+                return j
+
+            def add_observation(k, o, c, j):
                 if use_calib:
                     if o.jac_calib is None:
                         raise ValueError(f"{o.where}: calibration states need jac_calib and cov_frame")
@@ -499,28 +499,51 @@ class Slam:
                     if rbm is not None:
                         if o.u_px is None:
                             raise ValueError(f"{o.where}: --calib-model exact needs the observation's u_px, v_px")
-                        f = calib_factor_exact(X(i), L(j), o, cf, rbm, self._robust(), bk)
+                        f = calib_factor_exact(X(k), L(j), o, cf, rbm, self._robust(), bk)
                         st["exact_factors"] += 1
                     else:
-                        f = calib_factor(X(i), L(j), o, self._obs_noise(cf), bk)
+                        f = calib_factor(X(k), L(j), o, self._obs_noise(cf), bk)
                 else:
-                    f = gtsam.BearingRangeFactor2D(X(i), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
+                    f = gtsam.BearingRangeFactor2D(X(k), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
                                                    self._obs_noise(c))
                 graph.add(f)
                 new_f.add(f)
-                assoc.append((i, o, j))
+                assoc.append((k, o, j))
+                here.append((o, j))
                 st["used"] += 1
-            seen = sorted({j for (k, o, j) in assoc[-len(usable):] if k == i})
+
+            st["dropped_unconfirmed"] += pending.expire(i)
+            for o, c, j in zip(usable, covs, targets):
+                if j == -3:
+                    st["dropped_ambiguous"] += 1
+                    continue
+                if j == -4:
+                    st["dropped_imprecise"] += 1
+                    continue
+                if mode == "known" or (mode == "mixed" and o.lm_id is not None):
+                    j = id_to_lm.get(o.lm_id, -1)   # may have been created earlier this frame
+                elif j == -1 and p.init_views > 1:
+                    cand = pending.add(i, cur, o, c)
+                    if cand is None:
+                        continue                    # waits in the candidate buffer
+                    j = new_landmark(o, pending.mean(cand)[0])
+                    for (k, ok, ck) in cand["views"]:
+                        add_observation(k, ok, ck, j)
+                    continue
+                if j == -1:
+                    j = new_landmark(o, rb_to_world(cur, o.range_m, o.bearing_rad))
+                add_observation(i, o, c, j)
+            seen = sorted({j for (o, j) in here})
             co_seen.update((a, b) for x, a in enumerate(seen) for b in seen[x + 1:])
             if self.on_step:
-                self.on_step(i, s.seq, s.t, cur, [(o, j) for (k, o, j) in assoc[-len(usable):] if k == i],
-                             isam, lms_init)
+                self.on_step(i, s.seq, s.t, cur, here, isam, lms_init)
         if new_f.size() or new_v.size():
             isam.update(new_f, new_v)
             st["isam_updates"] += 1
         est = isam.calculateEstimate()
         t_isam = time.perf_counter() - t0
         st["merged_landmarks"] = len(merged_into)
+        st["dropped_unconfirmed"] += pending.expire(n + p.init_window)
         isam_poses = _poses(est, n)
         if p.batch:
             lp = gtsam.LevenbergMarquardtParams()
@@ -744,6 +767,60 @@ def _root(merged_into, j):
     while j in merged_into:
         j = merged_into[j]
     return j
+
+
+class CandidateBuffer:
+    """Delayed landmark initialisation: observations that would start a landmark wait here until
+    `views` of them, from distinct steps and of one class, agree on a point in the plane (each new
+    view within the gate of the candidate's mean, their covariances in the plane from range and
+    bearing, the pose taken as known); a candidate not seen again within `window` steps is dropped."""
+
+    def __init__(self, views, window, gate):
+        self.views, self.window, self.gate = views, window, gate
+        self.cands = []                     # dict(cls, views [(step, obs, cov)], pts, infos, last)
+
+    @staticmethod
+    def _point(pose, o, cov):
+        a = pose[2] + o.bearing_rad
+        J = np.array([[math.cos(a), -o.range_m * math.sin(a)], [math.sin(a), o.range_m * math.cos(a)]])
+        return rb_to_world(pose, o.range_m, o.bearing_rad), J @ cov @ J.T
+
+    def add(self, step, pose, o, cov):
+        """File the observation; returns its candidate once confirmed (and leaves it out of the
+        buffer), else None."""
+        w, C = self._point(pose, o, cov)
+        best, bd = None, self.gate
+        for c in self.cands:
+            if c["cls"] != o.cls or c["last"] == step:
+                continue
+            m, P = self.mean(c)
+            d = w - m
+            d2 = float(d @ np.linalg.solve(P + C, d))
+            if d2 <= bd:
+                best, bd = c, d2
+        if best is None:
+            best = dict(cls=o.cls, views=[], pts=[], infos=[], last=step)
+            self.cands.append(best)
+        best["views"].append((step, o, cov))
+        best["pts"].append(w)
+        best["infos"].append(np.linalg.inv(C))
+        best["last"] = step
+        if len(best["views"]) >= self.views:
+            self.cands.remove(best)
+            return best
+        return None
+
+    @staticmethod
+    def mean(c):
+        """The information-weighted mean of a candidate's points and its covariance."""
+        P = np.linalg.inv(sum(c["infos"]))
+        return P @ sum(I @ w for I, w in zip(c["infos"], c["pts"])), P
+
+    def expire(self, step):
+        """Drops the candidates not seen since step - window; returns how many observations they held."""
+        old = [c for c in self.cands if step - c["last"] > self.window]
+        self.cands = [c for c in self.cands if step - c["last"] <= self.window]
+        return sum(len(c["views"]) for c in old)
 
 
 class Information:

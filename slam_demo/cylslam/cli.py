@@ -51,7 +51,7 @@ def _params(args, **over):
                cand_radius=args.cand_radius, init_max_sigma=args.init_max_sigma, robust=args.robust, huber_k=args.huber_k,
                anchor=args.anchor, batch=not args.no_batch, reject_flags=int(args.reject_flags, 0),
                exclusion=getattr(args, "exclusion", False), joint=getattr(args, "assoc_method", "") == "jcbb",
-               merge_every=getattr(args, "merge_every", 0),
+               merge_every=getattr(args, "merge_every", 0), init_views=getattr(args, "init_views", 1),
                calib_states=getattr(args, "calib_states", False),
                lm_bias=getattr(args, "lm_bias", "auto"),
                calib_model=getattr(args, "calib_model", "linear"),
@@ -335,6 +335,10 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
                    help="unknown association: an observation whose compatible landmarks are all "
                         "taken by other observations of its frame starts a landmark (one landmark "
                         "gives one observation a frame) instead of being dropped as ambiguous")
+    g.add_argument("--init-views", type=int, default=1, metavar="K",
+                   help="unknown association: a landmark starts once K views from distinct steps agree "
+                        "on its point (a candidate buffer; views not confirmed within 50 steps are "
+                        "dropped and counted) (default %(default)s: at once)")
     g.add_argument("--merge-every", type=int, default=0, metavar="N",
                    help="unknown association: every N steps, merge two landmarks of a class never "
                         "seen in one frame whose difference passes the gate (default 0: never)")

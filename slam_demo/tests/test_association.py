@@ -253,3 +253,39 @@ def test_a_duplicate_is_merged_and_reported_once():
     assert np.allclose(res.lms[0], A, atol=1e-3) and np.allclose(res.poses[:, 0], 0.0, atol=2e-3)
     m = metrics.evaluate(ds, res)
     assert m["association_errors"] == 0 and m["anees_landmarks_joint"] is not None
+
+
+def _drive(views, odom=(0.05, 0.0, 0.0)):
+    """Steps with the given observations (list per step) from poses odom apart, truth = odometry."""
+    steps, pose = [], np.zeros(3)
+    for k, obs in enumerate(views):
+        if k:
+            pose = pose + np.array(odom)
+        steps.append(Step(t=k, seq=k, odom=None if k == 0 else np.array(odom, float),
+                          odom_cov=None if k == 0 else np.diag([1e-6] * 3), truth=pose.copy(),
+                          obs=[_obs(pose, lm, np.diag([0.02 ** 2, 0.005 ** 2])) for lm in obs]))
+    return Dataset(name="buffer", steps=steps)
+
+
+def test_candidate_buffer_starts_a_landmark_from_agreeing_views_only():
+    """init_views 2: a blob seen once (clutter) never becomes a landmark and is counted; a post seen
+    twice does, at the mean of its views, and both views are its observations (the first at its own
+    step); two views in one step do not confirm each other."""
+    A, C, D = np.array([3.0, 0.5]), np.array([2.0, -1.0]), np.array([4.0, 2.0])
+    ds = _drive([[A, C], [A], [D, D + [0.01, 0.0]], []])
+    res = backend.Slam(backend.Params(assoc="unknown", init_views=2)).run(ds)
+    assert len(res.lms) == 1 and np.allclose(res.lms[0], A, atol=1e-3)
+    assert [(k, j) for (k, _, j) in res.assoc] == [(0, 0), (1, 0)]
+    assert res.stats["dropped_unconfirmed"] == 3       # C once, D twice in one step
+    at_once = backend.Slam(backend.Params(assoc="unknown")).run(ds)
+    assert len(at_once.lms) == 4 and at_once.stats["dropped_unconfirmed"] == 0   # D twice, as two
+
+
+def test_candidate_buffer_forgets_a_view_after_its_window():
+    A = np.array([3.0, 0.5])
+    gap = [[A]] + [[]] * 6 + [[A], [A]]
+    ds = _drive(gap, odom=(0.0, 0.0, 0.0))
+    res = backend.Slam(backend.Params(assoc="unknown", init_views=2, init_window=5)).run(ds)
+    assert [k for (k, _, _) in res.assoc] == [7, 8] and res.stats["dropped_unconfirmed"] == 1
+    res = backend.Slam(backend.Params(assoc="unknown", init_views=2, init_window=10)).run(ds)
+    assert [k for (k, _, _) in res.assoc] == [0, 7, 8] and res.stats["dropped_unconfirmed"] == 0
