@@ -193,7 +193,7 @@ def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_ke
             H[1] = ai @ hl
             H[2] = -ai @ jd
             if bias_key is not None:
-                H[3] = np.eye(2)                         # zhat(u - b): d e / d b = A^-1 A
+                H[3] = np.eye(2)                         # zhat(u - b): d e / d b = A^-1 A (A^-1 held, Gauss-Newton)
         return ai @ e
 
     keys = [pose_key, lm_key, CALIB] + ([bias_key] if bias_key is not None else [])
@@ -395,6 +395,8 @@ class Slam:
         merged_into = {}                    # landmark -> the landmark it was merged into
         pending = CandidateBuffer(p.init_views, p.init_window, chi2_2dof(p.gate_p))
         co_seen = set()                     # (j, k), j < k: landmarks observed in one frame
+        step_lms = {}                       # step -> the landmarks observed at it
+        last_merge = 0                      # the step of the last search for duplicates
         gate = chi2_2dof(p.gate_p)
         new_thr = chi2_2dof(p.new_p)
         for i, s in enumerate(steps):
@@ -426,7 +428,8 @@ class Slam:
                 last_update = i
                 e = isam.calculateEstimatePose2(X(i))
                 cur = np.array([e.x(), e.y(), e.theta()])
-                if mode == "unknown" and p.merge_every and i % p.merge_every == 0 and i:
+                if mode == "unknown" and p.merge_every and i - last_merge >= p.merge_every:
+                    last_merge = i
                     ties = gtsam.NonlinearFactorGraph()
                     for f in self._merge(isam, by_class, merged_into, co_seen, gate, st):
                         graph.add(f)
@@ -509,7 +512,11 @@ class Slam:
                 graph.add(f)
                 new_f.add(f)
                 assoc.append((k, o, j))
-                here.append((o, j))
+                if k == i:
+                    here.append((o, j))
+                seen = step_lms.setdefault(k, set())
+                co_seen.update((min(j, x), max(j, x)) for x in seen if x != j)
+                seen.add(j)
                 st["used"] += 1
 
             st["dropped_unconfirmed"] += pending.expire(i)
@@ -533,8 +540,6 @@ class Slam:
                 if j == -1:
                     j = new_landmark(o, rb_to_world(cur, o.range_m, o.bearing_rad))
                 add_observation(i, o, c, j)
-            seen = sorted({j for (o, j) in here})
-            co_seen.update((a, b) for x, a in enumerate(seen) for b in seen[x + 1:])
             if self.on_step:
                 self.on_step(i, s.seq, s.t, cur, here, isam, lms_init)
         if new_f.size() or new_v.size():
@@ -591,7 +596,10 @@ class Slam:
         at most one observation per landmark, the one with the most pairings whose joint innovation
         is compatible (NIS <= chi2_2k(gate_p), with the current pose's and the landmarks' joint
         covariance: the pose error, common to all pairings, is counted once), the lowest NIS among
-        equals. Returns the column per observation as the Hungarian does (c < ncand: candidate c)."""
+        equals. As in JCBB, a hypothesis grows one observation at a time and each extension must pass
+        its own gate, so a hypothesis whose shorter part fails is not reached (the result may depend
+        on the observations' order); the search is exhaustive within that, which is cheap for the
+        few observations and at most max_cands candidates of a frame. Returns the column per observation as the Hungarian does (c < ncand: candidate c)."""
         col = {j: k for k, j in enumerate(allc)}
         dim = 3 + 2 * len(allc)
         Sig = np.zeros((dim, dim))

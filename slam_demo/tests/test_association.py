@@ -61,58 +61,67 @@ class _JointMarginal:
         return self.cov[i:i + m, j:j + n]
 
 
-def _problem(cur, lms, zs, R, sig_pose, sig_lm):
-    allc = list(range(len(lms)))
+def _problem(cur, lms, zs, R, sig_pose, sig_lm, ids=None, cands=None, corr=None):
+    """One frame's association problem as Slam._associate hands it to _jcbb: landmarks `lms` with
+    ids `ids` (default 0..m-1), candidates per observation `cands` (default all), the joint covariance
+    of pose and landmarks block-diagonal with the given sigmas plus `corr` (a symmetric matrix added,
+    the pose-landmark and landmark-landmark correlations)."""
+    ids = list(range(len(lms))) if ids is None else list(ids)
+    col = {j: k for k, j in enumerate(ids)}
     dim = 3 + 2 * len(lms)
     cov = np.zeros((dim, dim))
     cov[:3, :3] = np.diag(np.square(sig_pose))
     cov[3:, 3:] = np.eye(2 * len(lms)) * sig_lm ** 2
-    jm = _JointMarginal([X(0)] + [L(j) for j in allc], [3] + [2] * len(lms), cov)
+    if corr is not None:
+        cov = cov + corr
+    jm = _JointMarginal([X(0)] + [L(j) for j in ids], [3] + [2] * len(lms), cov)
     gate = backend.chi2_2dof(0.99)
+    cands = [ids for _ in zs] if cands is None else cands
+    lm_est = {j: np.asarray(lms[col[j]], float) for j in ids}
     d2s = []
-    for z in zs:
+    for z, cs in zip(zs, cands):
         d = {}
-        for j in allc:
-            h, H = backend.predict_rb(cur, lms[j])
-            Sg = np.zeros((5, 5))
-            Sg[:3, :3], Sg[3:, 3:] = cov[:3, :3], cov[3 + 2 * j:5 + 2 * j, 3 + 2 * j:5 + 2 * j]
-            nu = z - h
+        for j in cs:
+            h, H = backend.predict_rb(cur, lm_est[j])
+            o = 3 + 2 * col[j]
+            idx = np.r_[0:3, o:o + 2]
+            nu = np.asarray(z, float) - h
             nu[1] = wrap(nu[1])
-            d[j] = float(nu @ np.linalg.solve(H @ Sg @ H.T + R, nu))
+            d[j] = float(nu @ np.linalg.solve(H @ cov[np.ix_(idx, idx)] @ H.T + R, nu))
         d2s.append(d)
-    usable = [None] * len(zs)
-    cands = [allc for _ in zs]
-    lm_est = {j: np.asarray(lms[j], float) for j in allc}
-    return dict(xkey=X(0), usable=usable, zs=[np.asarray(z, float) for z in zs], covs=[R] * len(zs),
-                cands=cands, d2s=d2s, allc=allc, lm_est=lm_est, cur=cur, jm=jm, gate=gate,
-                ncand=len(allc)), cov
+    return dict(xkey=X(0), usable=[None] * len(zs), zs=[np.asarray(z, float) for z in zs], covs=[R] * len(zs),
+                cands=cands, d2s=d2s, allc=ids, lm_est=lm_est, cur=cur, jm=jm, gate=gate,
+                ncand=len(ids)), cov
 
 
 def _joint_nis(pb, cov, hyp):
+    col = {j: k for k, j in enumerate(pb["allc"])}
     pairs = [(a, j) for a, j in enumerate(hyp) if j is not None]
+    if not pairs:
+        return 0.0
     nus, Hs = [], []
     for a, j in pairs:
         h, H = backend.predict_rb(pb["cur"], pb["lm_est"][j])
         Hr = np.zeros((2, cov.shape[0]))
         Hr[:, :3] = H[:, :3]
-        Hr[:, 3 + 2 * j:5 + 2 * j] = H[:, 3:]
+        o = 3 + 2 * col[j]
+        Hr[:, o:o + 2] = H[:, 3:]
         nu = pb["zs"][a] - h
         nu[1] = wrap(nu[1])
         nus.append(nu)
         Hs.append(Hr)
-    if not pairs:
-        return 0.0
     nu, Hm = np.concatenate(nus), np.vstack(Hs)
     S = Hm @ cov @ Hm.T + np.kron(np.eye(len(pairs)), pb["covs"][0])
     return float(nu @ np.linalg.solve(S, nu))
 
 
 def _brute_force(pb, cov, p=0.99):
-    """Every hypothesis (each observation to a distinct individually gated landmark or none) whose
-    pairings, added in observation order, pass the joint gate at each step; the most pairings, then
+    """Every hypothesis (each observation to a distinct individually gated candidate of its own, or
+    none) whose pairings, added in observation order, pass the joint gate at each step (the rule of
+    branch and bound, which extends a hypothesis one observation at a time); the most pairings, then
     the least joint NIS."""
     n = len(pb["zs"])
-    opts = [[None] + [j for j in pb["allc"] if pb["d2s"][a][j] <= pb["gate"]] for a in range(n)]
+    opts = [[None] + [j for j in pb["cands"][a] if pb["d2s"][a][j] <= pb["gate"]] for a in range(n)]
     best = None
     for hyp in itertools.product(*opts):
         js = [j for j in hyp if j is not None]
@@ -133,11 +142,14 @@ def _brute_force(pb, cov, p=0.99):
 
 
 def test_jcbb_matches_brute_force():
+    """Random frames: landmark ids that are not column numbers, each observation with its own
+    candidates, and a joint covariance with pose-landmark and landmark-landmark correlations."""
     rng = np.random.default_rng(11)
     slam = backend.Slam(backend.Params(assoc="unknown", joint=True))
     checked = 0
-    for _ in range(40):
+    for _ in range(60):
         m, n = int(rng.integers(2, 5)), int(rng.integers(1, 4))
+        ids = sorted(rng.choice(40, m, replace=False).tolist())
         lms = [np.array([3.0, 0.0]) + rng.normal(0, 0.3, 2) for _ in range(m)]
         cur = np.array([0.0, 0.0, rng.normal(0, 0.02)])
         R = np.diag([0.1 ** 2, 0.03 ** 2])
@@ -145,12 +157,15 @@ def test_jcbb_matches_brute_force():
         for _ in range(n):
             h, _ = backend.predict_rb(np.zeros(3), lms[int(rng.integers(m))])
             zs.append(h + rng.normal(0, [0.1, 0.03]))
-        pb, cov = _problem(cur, lms, zs, R, [0.05, 0.05, 0.05], 0.1)
+        cands = [sorted(rng.choice(ids, int(rng.integers(1, m + 1)), replace=False).tolist()) for _ in range(n)]
+        G = rng.normal(0, 0.05, (3 + 2 * m, 3 + 2 * m))   # correlations strong enough to change choices
+        pb, cov = _problem(cur, lms, zs, R, [0.05, 0.05, 0.05], 0.1, ids=ids, cands=cands, corr=G @ G.T)
         got = slam._jcbb(**pb)
         want = _brute_force(pb, cov)
         got_j = [pb["allc"][c] if c < pb["ncand"] else None for c in got]
-        assert _joint_nis(pb, cov, got_j) == pytest.approx(_joint_nis(pb, cov, want), rel=1e-9, abs=1e-12)
+        assert all(j is None or j in pb["cands"][a] for a, j in enumerate(got_j))
         assert sum(j is not None for j in got_j) == sum(j is not None for j in want)
+        assert _joint_nis(pb, cov, got_j) == pytest.approx(_joint_nis(pb, cov, want), rel=1e-9, abs=1e-12)
         checked += sum(j is not None for j in want) >= 2
     assert checked >= 10      # enough cases with two or more pairings
 
@@ -289,3 +304,21 @@ def test_candidate_buffer_forgets_a_view_after_its_window():
     assert [k for (k, _, _) in res.assoc] == [7, 8] and res.stats["dropped_unconfirmed"] == 1
     res = backend.Slam(backend.Params(assoc="unknown", init_views=2, init_window=10)).run(ds)
     assert [k for (k, _, _) in res.assoc] == [0, 7, 8] and res.stats["dropped_unconfirmed"] == 0
+
+
+def test_views_that_wait_in_the_buffer_still_count_as_seen_together():
+    """A and B are seen together at step 0; A is confirmed at step 1, B only at step 3 from its step-0
+    view and a new one. Their step-0 views make them landmarks seen in one frame, which merging must
+    never join, although no later step sees both."""
+    A, B = np.array([3.0, 0.5]), np.array([3.0, -0.5])
+    ds = _drive([[A, B], [A], [], [B], [A]], odom=(0.0, 0.0, 0.0))
+    got = []
+
+    class Spy(backend.Slam):
+        def _merge(self, isam, by_class, merged_into, co_seen, gate, st):
+            got.append(set(co_seen))
+            return super()._merge(isam, by_class, merged_into, co_seen, gate, st)
+
+    res = Spy(backend.Params(assoc="unknown", init_views=2, merge_every=1)).run(ds)
+    assert len(res.lms) == 2 and [(k, j) for (k, _, j) in res.assoc] == [(0, 0), (1, 0), (0, 1), (3, 1), (4, 0)]
+    assert (0, 1) in got[-1]
