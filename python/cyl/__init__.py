@@ -281,6 +281,7 @@ class RangeBearing:
         if model not in self.GEOM:
             raise ValueError(f"model '{model}': one of {sorted(self.GEOM)}")
         self.model = self.GEOM[model]
+        self.calib_columns = np.array(self.CALIB_INPUTS)   # jac's columns of the delta's entries
         n = lib.CYL_IN_COUNT
         nominal = ffi.new("double[]", n)
         lib.cyl_rb_inputs(camera._c, 0.0, 0.0, nominal)
@@ -298,7 +299,7 @@ class RangeBearing:
         self._inbuf[:] = self.nominal
         self._inbuf[0], self._inbuf[1] = u_px, v_px
         if delta is not None:
-            self._inbuf[list(self.CALIB_INPUTS)] += np.asarray(delta, float)
+            self._inbuf[self.calib_columns] += np.asarray(delta, float)
         st = lib.cyl_rb_eval(self._in, self.model, self._out, ffi.NULL, self._jac, ffi.NULL)
         if st != 0:
             return None

@@ -179,8 +179,8 @@ def _rb_by_hand(cam, u, v):
 
 def test_range_bearing_model():
     """cyl.RangeBearing: the C model by hand on a lens without distortion, a calibration error equal
-    to a camera moved by it, its Jacobians by central differences, None above the horizon, and the
-    observation log's range and bearing reproduced from its pixel and its header's camera."""
+    to a camera moved by it, its Jacobians by central differences, None above the horizon, an
+    unknown model name refused."""
     cam = cyl.Camera(640, 480, fx=570, fy=568, cx=322.4, cy=236.9, tilt_rad=0.2094, yaw_rad=0.01,
                      height_m=0.326, offset_m=0.1)
     rb = cyl.RangeBearing(cam)

@@ -169,7 +169,7 @@ def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_ke
     if robust is not None:
         noise = gtsam.noiseModel.Robust.Create(robust, noise)
     z = np.array([o.bearing_rad, o.range_m])
-    cal = list(rbm.CALIB_INPUTS)
+    cal = rbm.calib_columns
 
     def error(this, values, H):
         p = values.atPose2(pose_key)
@@ -186,7 +186,7 @@ def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_ke
             jd, a = jbr, a0
             zhat = z + jd @ d - a @ bb
         e = np.array([b, r]) - zhat
-        e[0] = (e[0] + np.pi) % (2 * np.pi) - np.pi
+        e[0] = wrap(e[0])
         ai = np.linalg.inv(a)
         if H is not None:
             H[0] = ai @ hp
@@ -393,12 +393,68 @@ class Slam:
                   marginal_calls=0, new_by_exclusion=0, dropped_unconfirmed=0, association=mode, by_identity=0, bias_states=0, exact_factors=0)
         last_update = 0
         merged_into = {}                    # landmark -> the landmark it was merged into
-        pending = CandidateBuffer(p.init_views, p.init_window, chi2_2dof(p.gate_p))
         co_seen = set()                     # (j, k), j < k: landmarks observed in one frame
         step_lms = {}                       # step -> the landmarks observed at it
         last_merge = 0                      # the step of the last search for duplicates
         gate = chi2_2dof(p.gate_p)
         new_thr = chi2_2dof(p.new_p)
+        pending = CandidateBuffer(p.init_views, p.init_window, gate)
+
+        # a landmark's start and an observation's factor; `i`, `here`, `new_f` and `new_v` are
+        # read from the step being processed when they are called
+        def new_landmark(o, pos):
+            j = len(lms_init)
+            lms_init.append(np.asarray(pos, float))
+            lm_class.append(o.cls)
+            lm_ids.append(o.lm_id)
+            by_class.setdefault(o.cls, []).append(j)
+            if o.lm_id is not None and mode in ("known", "mixed"):
+                id_to_lm[o.lm_id] = j
+            new_v.insert(L(j), gtsam.Point2(*pos))
+            var = self._bias_prior(o, use_calib)
+            lm_bias[j] = var
+            if var is not None:
+                new_v.insert(B(j), np.zeros(2))
+                f = gtsam.PriorFactorVector(B(j), np.zeros(2), gtsam.noiseModel.Diagonal.Variances(var))
+                graph.add(f)
+                new_f.add(f)
+                st["bias_states"] += 1
+            st["new_landmarks"] += 1
+            return j
+
+        def add_observation(k, o, c, j):
+            if use_calib:
+                if o.jac_calib is None:
+                    raise ValueError(f"{o.where}: calibration states need jac_calib and cov_frame")
+                cf = o.cov_frame
+                if lm_bias[j] is not None and o.bias_var_px2 is not None:
+                    # the bias is the landmark's state now, not noise of this frame: as much of
+                    # it as the state's prior covers
+                    jpx = o.jac_calib[:, 2:4]
+                    cf = cf - jpx @ np.diag(np.minimum(o.bias_var_px2, lm_bias[j])) @ jpx.T
+                if p.fixed_frame_cov is not None:
+                    cf = p.fixed_frame_cov
+                bk = B(j) if lm_bias[j] is not None else None
+                if rbm is not None:
+                    if o.u_px is None:
+                        raise ValueError(f"{o.where}: --calib-model exact needs the observation's u_px, v_px")
+                    f = calib_factor_exact(X(k), L(j), o, cf, rbm, self._robust(), bk)
+                    st["exact_factors"] += 1
+                else:
+                    f = calib_factor(X(k), L(j), o, self._obs_noise(cf), bk)
+            else:
+                f = gtsam.BearingRangeFactor2D(X(k), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
+                                               self._obs_noise(c))
+            graph.add(f)
+            new_f.add(f)
+            assoc.append((k, o, j))
+            if k == i:
+                here.append((o, j))
+            seen = step_lms.setdefault(k, set())
+            co_seen.update((min(j, x), max(j, x)) for x in seen if x != j)
+            seen.add(j)
+            st["used"] += 1
+
         for i, s in enumerate(steps):
             if self.progress:
                 self.progress(i + 1, n)
@@ -465,59 +521,6 @@ class Slam:
                 targets = self._associate(isam, i, cur, usable, covs, lms_init, lm_class,
                                           by_class, gate, new_thr, st)
             here = []                       # (observation, landmark) used at this step
-
-            def new_landmark(o, pos):
-                j = len(lms_init)
-                lms_init.append(np.asarray(pos, float))
-                lm_class.append(o.cls)
-                lm_ids.append(o.lm_id)
-                by_class.setdefault(o.cls, []).append(j)
-                if o.lm_id is not None and mode in ("known", "mixed"):
-                    id_to_lm[o.lm_id] = j
-                new_v.insert(L(j), gtsam.Point2(*pos))
-                var = self._bias_prior(o, use_calib)
-                lm_bias[j] = var
-                if var is not None:
-                    new_v.insert(B(j), np.zeros(2))
-                    f = gtsam.PriorFactorVector(B(j), np.zeros(2), gtsam.noiseModel.Diagonal.Variances(var))
-                    graph.add(f)
-                    new_f.add(f)
-                    st["bias_states"] += 1
-                st["new_landmarks"] += 1
-                return j
-
-            def add_observation(k, o, c, j):
-                if use_calib:
-                    if o.jac_calib is None:
-                        raise ValueError(f"{o.where}: calibration states need jac_calib and cov_frame")
-                    cf = o.cov_frame
-                    if lm_bias[j] is not None and o.bias_var_px2 is not None:
-                        # the bias is the landmark's state now, not noise of this frame: as much of
-                        # it as the state's prior covers
-                        jpx = o.jac_calib[:, 2:4]
-                        cf = cf - jpx @ np.diag(np.minimum(o.bias_var_px2, lm_bias[j])) @ jpx.T
-                    if p.fixed_frame_cov is not None:
-                        cf = p.fixed_frame_cov
-                    bk = B(j) if lm_bias[j] is not None else None
-                    if rbm is not None:
-                        if o.u_px is None:
-                            raise ValueError(f"{o.where}: --calib-model exact needs the observation's u_px, v_px")
-                        f = calib_factor_exact(X(k), L(j), o, cf, rbm, self._robust(), bk)
-                        st["exact_factors"] += 1
-                    else:
-                        f = calib_factor(X(k), L(j), o, self._obs_noise(cf), bk)
-                else:
-                    f = gtsam.BearingRangeFactor2D(X(k), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
-                                                   self._obs_noise(c))
-                graph.add(f)
-                new_f.add(f)
-                assoc.append((k, o, j))
-                if k == i:
-                    here.append((o, j))
-                seen = step_lms.setdefault(k, set())
-                co_seen.update((min(j, x), max(j, x)) for x in seen if x != j)
-                seen.add(j)
-                st["used"] += 1
 
             st["dropped_unconfirmed"] += pending.expire(i)
             for o, c, j in zip(usable, covs, targets):
@@ -590,49 +593,31 @@ class Slam:
                       lm_cov=lm_cov, lm_class=lm_class, lm_ids=lm_ids, assoc=assoc, stats=st,
                       info=info, lm_keys=lm_keys)
 
-    def _jcbb(self, xkey, usable, zs, covs, cands, d2s, allc, lm_est, cur, jm, gate, ncand):
+    def _jcbb(self, gated, covs, cands, Sig, nobs):
         """Joint compatibility branch and bound (Neira and Tardos 2001): among the hypotheses that
-        pair each observation with an individually compatible candidate (d2 <= gate) or with none,
-        at most one observation per landmark, the one with the most pairings whose joint innovation
-        is compatible (NIS <= chi2_2k(gate_p), with the current pose's and the landmarks' joint
-        covariance: the pose error, common to all pairings, is counted once), the lowest NIS among
-        equals. As in JCBB, a hypothesis grows one observation at a time and each extension must pass
-        its own gate, so a hypothesis whose shorter part fails is not reached (the result may depend
-        on the observations' order); the search is exhaustive within that, which is cheap for the
-        few observations and at most max_cands candidates of a frame. Returns the column per observation as the Hungarian does (c < ncand: candidate c)."""
-        col = {j: k for k, j in enumerate(allc)}
-        dim = 3 + 2 * len(allc)
-        Sig = np.zeros((dim, dim))
-        blocks = [("x", None)] + [("l", j) for j in allc]
-
-        def key(b):
-            return xkey if b[0] == "x" else L(b[1])
-        off = [0] + [3 + 2 * k for k in range(len(allc))]
-        sz = [3] + [2] * len(allc)
-        for a_, ba in enumerate(blocks):
-            for b_, bb in enumerate(blocks):
-                Sig[off[a_]:off[a_] + sz[a_], off[b_]:off[b_] + sz[b_]] = jm.at(key(ba), key(bb))
-        pre = {}
-        for a, cs in enumerate(cands):
-            for j in cs:
-                if d2s[a].get(j, np.inf) <= gate:
-                    h, H = predict_rb(cur, lm_est[j])
-                    nu = zs[a] - h
-                    nu[1] = wrap(nu[1])
-                    Hrow = np.zeros((2, dim))
-                    Hrow[:, 0:3] = H[:, 0:3]
-                    c = 3 + 2 * col[j]
-                    Hrow[:, c:c + 2] = H[:, 3:5]
-                    pre[a, j] = (nu, Hrow)
-        nobs = len(usable)
+        pair each observation with an individually compatible candidate (`gated`: (observation,
+        landmark) -> (innovation, its 2x5 Jacobian, the pose's and the landmark's rows of Sig)) or
+        with none, at most one observation per landmark, the one with the most pairings whose joint
+        innovation is compatible (NIS <= chi2_2k(gate_p), with Sig the current pose's and the
+        candidates' joint covariance: the pose error, common to all pairings, is counted once), the
+        lowest NIS among equals. As in JCBB, a hypothesis grows one observation at a time and each
+        extension must pass its own gate, so a hypothesis whose shorter part fails is not reached (the
+        result may depend on the observations' order); the search is exhaustive within that, which
+        is cheap for the few observations and at most max_cands candidates of a frame. Returns the
+        landmark per observation, or None."""
+        rows = {}
+        for key, (nu, H, idx) in gated.items():
+            Hrow = np.zeros((2, Sig.shape[0]))
+            Hrow[:, idx] = H
+            rows[key] = (nu, Hrow)
         best = {"n": 0, "nis": 0.0, "h": [None] * nobs}
 
         def nis(hyp):
             pairs = [(a, j) for a, j in enumerate(hyp) if j is not None]
             if not pairs:
                 return 0.0
-            nu = np.concatenate([pre[p][0] for p in pairs])
-            Hm = np.vstack([pre[p][1] for p in pairs])
+            nu = np.concatenate([rows[p][0] for p in pairs])
+            Hm = np.vstack([rows[p][1] for p in pairs])
             S = Hm @ Sig @ Hm.T
             for k, (a, _) in enumerate(pairs):
                 S[2 * k:2 * k + 2, 2 * k:2 * k + 2] += covs[a]
@@ -647,7 +632,7 @@ class Slam:
             if npair + (nobs - a) < best["n"]:
                 return                                   # cannot beat the best any more
             for j in cands[a]:
-                if (a, j) in pre and j not in used:
+                if (a, j) in rows and j not in used:
                     hyp[a] = j
                     if nis(hyp) <= chi2_2k(self.p.gate_p, npair + 1):
                         dfs(a + 1, hyp, npair + 1, used | {j})
@@ -655,7 +640,7 @@ class Slam:
             dfs(a + 1, hyp, npair, used)
 
         dfs(0, [None] * nobs, 0, frozenset())
-        return [col[j] if j is not None else ncand + a for a, j in enumerate(best["h"])]
+        return best["h"]
 
     def _merge(self, isam, by_class, merged_into, co_seen, gate, st):
         """Duplicate landmarks: two of a class, never observed in one frame, within cand_radius + 3
@@ -665,6 +650,13 @@ class Slam:
         factors."""
         out = []
         noise = gtsam.noiseModel.Isotropic.Sigma(2, 1e-3)
+        est, spread = {}, {}                # per landmark: estimate, sqrt of its covariance's trace
+
+        def at(j):
+            if j not in est:
+                est[j] = np.asarray(isam.calculateEstimatePoint2(L(j)), float)
+                spread[j] = math.sqrt(np.trace(isam.marginalCovariance(L(j))))
+            return est[j], spread[j]
         for cls, js in by_class.items():
             for x, j in enumerate(js):
                 if j in merged_into:
@@ -672,11 +664,9 @@ class Slam:
                 for k in js[x + 1:]:
                     if k in merged_into or j in merged_into or (min(j, k), max(j, k)) in co_seen:
                         continue
-                    pj = isam.calculateEstimatePoint2(L(j))
-                    pk = isam.calculateEstimatePoint2(L(k))
-                    dlt = np.array([pk[0] - pj[0], pk[1] - pj[1]])
-                    spread = sum(math.sqrt(np.trace(isam.marginalCovariance(L(x)))) for x in (j, k))
-                    if math.hypot(*dlt) > self.p.cand_radius + 3.0 * spread:
+                    (pj, sj), (pk, sk) = at(j), at(k)
+                    dlt = pk - pj
+                    if math.hypot(*dlt) > self.p.cand_radius + 3.0 * (sj + sk):
                         continue
                     jm = isam.jointMarginalCovariance([L(j), L(k)])
                     st["marginal_calls"] += 1
@@ -715,38 +705,34 @@ class Slam:
         allc = sorted({j for cs in cands for j in cs})
         if not allc:
             return [-1 if s <= self.p.init_max_sigma else -4 for s in sig]
-        keys = [X(i)] + [L(j) for j in allc]
-        jm = isam.jointMarginalCovariance(keys)
+        # the joint covariance of the pose and every candidate, in this key order (pose: rows 0-2,
+        # landmark allc[k]: rows 3 + 2k, 4 + 2k)
+        Sig = isam.jointMarginalCovariance([X(i)] + [L(j) for j in allc]).fullMatrix()
         st["marginal_calls"] += 1
-        Sxx = jm.at(X(i), X(i))
-        lm_est = {}
-        blocks = {}
+        col = {j: k for k, j in enumerate(allc)}
         for j in allc:
             pt = isam.calculateEstimatePoint2(L(j))
-            lm_est[j] = np.array([pt[0], pt[1]])
-            lms_init[j] = lm_est[j]
-            blocks[j] = (jm.at(X(i), L(j)), jm.at(L(j), L(j)))
-        col = {j: k for k, j in enumerate(allc)}
+            lms_init[j] = np.array([pt[0], pt[1]])
         nobs, ncand = len(usable), len(allc)
         BIG = 1e9
         cost = np.full((nobs, ncand + nobs), BIG)
         d2s = [dict() for _ in range(nobs)]
+        gated = {}                          # (observation, landmark) -> (innovation, H, rows of Sig)
         for a, (o, z, cs) in enumerate(zip(usable, zs, cands)):
-            R = covs[a]
             for j in cs:
-                h, H = predict_rb(cur, lm_est[j])
-                Sxl, Sll = blocks[j]
-                Sig = np.block([[Sxx, Sxl], [Sxl.T, Sll]])
-                S = H @ Sig @ H.T + R
+                h, H = predict_rb(cur, lms_init[j])
+                rows = np.r_[0:3, 3 + 2 * col[j]:5 + 2 * col[j]]
                 nu = z - h
                 nu[1] = wrap(nu[1])
-                d2 = float(nu @ np.linalg.solve(S, nu))
+                d2 = float(nu @ np.linalg.solve(H @ Sig[np.ix_(rows, rows)] @ H.T + covs[a], nu))
                 d2s[a][j] = d2
                 if d2 <= gate:
                     cost[a, col[j]] = d2
+                    gated[a, j] = (nu, H, rows)
             cost[a, ncand + a] = gate
         if self.p.joint:
-            sol = self._jcbb(X(i), usable, zs, covs, cands, d2s, allc, lm_est, cur, jm, gate, ncand)
+            pick = self._jcbb(gated, covs, cands, Sig, nobs)
+            sol = [col[j] if j is not None else ncand + a for a, j in enumerate(pick)]
         else:
             sol = hungarian(cost)
         taken = {allc[c] for a, c in enumerate(sol) if c < ncand and cost[a, c] < BIG}
@@ -785,7 +771,9 @@ class CandidateBuffer:
 
     def __init__(self, views, window, gate):
         self.views, self.window, self.gate = views, window, gate
-        self.cands = []                     # dict(cls, views [(step, obs, cov)], pts, infos, last)
+        self.cands = []                     # dict(cls, views [(step, obs, cov)], info: the sum of the
+                                            # views' information matrices, iw: of information @ point,
+                                            # last: the step of the newest view)
 
     @staticmethod
     def _point(pose, o, cov):
@@ -807,11 +795,12 @@ class CandidateBuffer:
             if d2 <= bd:
                 best, bd = c, d2
         if best is None:
-            best = dict(cls=o.cls, views=[], pts=[], infos=[], last=step)
+            best = dict(cls=o.cls, views=[], info=np.zeros((2, 2)), iw=np.zeros(2), last=step)
             self.cands.append(best)
+        info = np.linalg.inv(C)
         best["views"].append((step, o, cov))
-        best["pts"].append(w)
-        best["infos"].append(np.linalg.inv(C))
+        best["info"] = best["info"] + info
+        best["iw"] = best["iw"] + info @ w
         best["last"] = step
         if len(best["views"]) >= self.views:
             self.cands.remove(best)
@@ -821,8 +810,8 @@ class CandidateBuffer:
     @staticmethod
     def mean(c):
         """The information-weighted mean of a candidate's points and its covariance."""
-        P = np.linalg.inv(sum(c["infos"]))
-        return P @ sum(I @ w for I, w in zip(c["infos"], c["pts"])), P
+        P = np.linalg.inv(c["info"])
+        return P @ c["iw"], P
 
     def expire(self, step):
         """Drops the candidates not seen since step - window; returns how many observations they held."""

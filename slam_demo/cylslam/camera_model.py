@@ -11,11 +11,10 @@ from __future__ import annotations
 import os
 import sys
 
-# the header's camera fields, in cyl.Camera's keyword names (docs/formats.md; older logs lack the
-# distortion coefficients and cannot use the exact model)
-HEADER_FIELDS = {"width": "width", "height": "height", "fx": "fx", "fy": "fy", "cx": "cx", "cy": "cy",
-                 "k1": "k1", "k2": "k2", "p1": "p1", "p2": "p2", "k3": "k3", "tilt_rad": "tilt_rad",
-                 "yaw_rad": "yaw_rad", "height_m": "height_m", "offset_m": "offset_m"}
+# the header's camera fields the model needs, which are cyl.Camera's keyword names too
+# (docs/formats.md; older logs lack the distortion coefficients and cannot use the exact model)
+HEADER_FIELDS = ("width", "height", "fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3", "tilt_rad",
+                 "yaw_rad", "height_m", "offset_m")
 
 
 def import_binding():
@@ -52,5 +51,5 @@ def range_bearing_model(header):
     cyl, why = import_binding()
     if cyl is None:
         return None, why
-    c = cyl.Camera(**{HEADER_FIELDS[k]: cam[k] for k in HEADER_FIELDS})
+    c = cyl.Camera(**{k: cam[k] for k in HEADER_FIELDS})
     return cyl.RangeBearing(c, geom), None
