@@ -173,7 +173,7 @@ typedef struct bg_skip {
 
 /* Background pairs from sample x (even offset from the row's pairs) on: returns the first x' >= x
  * such that every pair in [x, x') has uv == 0 (and x' + 1 < x1 where a pair may be coloured).
- * Short gaps are walked by the scalar test (4 pairs); longer ones by the vector skip on the coarse
+ * Short gaps are walked by the scalar test (1 pair); longer ones by the vector skip on the coarse
  * chroma map, then the scalar test again for at most 8 pairs, since a block bit may be set by
  * another chroma of the block. Where the background's chroma keeps falling in blocks the map
  * cannot rule out, the vector skip costs more than it saves: after two short skips it is off for
@@ -185,7 +185,7 @@ CYL_HOT_INLINE uint32_t skip_background(const cyl_colortable *t, const uint8_t *
     const uint8_t *pu = up + (x / 2u) * cs, *pv = vp + (x / 2u) * cs;
     uint32_t xlim = x1;
     if (sk->fn) {
-        const uint32_t xw = x + 8u < x1 ? x + 8u : x1;
+        const uint32_t xw = x + 2u < x1 ? x + 2u : x1;
         while (x + 1u < xw && uv[pu[0]][pv[0]] == 0) { x += 2u; pu += cs; pv += cs; }
         if (x + 1u < xw) return x;   /* a pair that may be coloured */
         if (x + 1u < x1) {
@@ -259,8 +259,8 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
             m = uv[pu[0]][pv[0]];
             col = PAIR_COL(pu[0], pv[0]);
         } else {
-            if (extend && x - start >= 4u) {
-                /* a run that has lasted two pairs: extend it 16 pixels at a time (and, as
+            if (extend) {   /* cur != NONE: start < x */
+                /* an open run: extend it 16 pixels at a time (and, as
                  * with the skip, stop trying in a row where runs keep breaking early) */
                 const uint32_t xe0 = x;
                 x = 2u * extend(t, sy, su, sv, x / 2u, x1 / 2u, cur);
@@ -487,7 +487,11 @@ static void connect_rows(cyl_run *r, uint32_t pb, uint32_t pe, uint32_t cb, uint
     while (i < pe && j < ce) {
         uint32_t a0 = r[i].x, a1 = a0 + (uint32_t)(r[i].width - 1u) * xs;
         uint32_t b0 = r[j].x, b1 = b0 + (uint32_t)(r[j].width - 1u) * xs;
-        if (a0 <= b1 && b0 <= a1 && eq[r[i].cls] == eq[r[j].cls]) uf_union(r, i, j);
+        if (a0 <= b1 && b0 <= a1 && eq[r[i].cls] == eq[r[j].cls]) {
+            /* a run not yet joined is its own root: it joins i's root (smaller, as i < j) */
+            if (r[j].blob == j) r[j].blob = uf_find(r, i);
+            else uf_union(r, i, j);
+        }
         if (a1 < b1) i++; else j++;
     }
 }

@@ -139,15 +139,17 @@ CYL_SKIP_TARGET static uint32_t cyl_skip_i420_ssse3(const uint8_t *u, const uint
 }
 
 /* AVX2: 32 pairs at a time. The in-lane shuffles and packs leave the pairs permuted (U and V
- * alike), which is enough to tell that a block has no candidate; a block that has one goes to
- * the SSSE3 code, which finds the first in pair order. */
+ * alike), which is enough to tell that a block has no candidate; in a block that has one, a
+ * cross-lane permutation puts the hits back in pair order and the first is the answer. Less than
+ * 32 pairs left go to the SSSE3 code. */
 #if defined(__AVX2__)
 #define CYL_SKIP_TARGET_AVX2
 #else
 #define CYL_SKIP_TARGET_AVX2 __attribute__((target("avx2")))
 #endif
 
-CYL_SKIP_TARGET_AVX2 static inline int cyl_skip_none256(__m256i un, __m256i vn, const uint8_t (*map)[16])
+/* The candidate bytes among 32 (0xFF where the block bit is set), in the order the lanes hold them. */
+CYL_SKIP_TARGET_AVX2 static inline __m256i cyl_skip_hits256(__m256i un, __m256i vn, const uint8_t (*map)[16])
 {
     const __m256i bitlo = _mm256_setr_epi8(1, 2, 4, 8, 16, 32, 64, (char)128, 0, 0, 0, 0, 0, 0, 0, 0,
                                            1, 2, 4, 8, 16, 32, 64, (char)128, 0, 0, 0, 0, 0, 0, 0, 0);
@@ -157,8 +159,13 @@ CYL_SKIP_TARGET_AVX2 static inline int cyl_skip_none256(__m256i un, __m256i vn, 
     const __m256i hi = _mm256_broadcastsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)map[1]));
     __m256i a = _mm256_and_si256(_mm256_shuffle_epi8(lo, vn), _mm256_shuffle_epi8(bitlo, un));
     __m256i b = _mm256_and_si256(_mm256_shuffle_epi8(hi, vn), _mm256_shuffle_epi8(bithi, un));
-    __m256i h = _mm256_or_si256(a, b);
-    return _mm256_testz_si256(h, h);
+    return _mm256_or_si256(a, b);
+}
+
+/* one bit a pair, in pair order, from hit bytes already in pair order */
+CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_skip_bits256(__m256i h)
+{
+    return ~(unsigned)_mm256_movemask_epi8(_mm256_cmpeq_epi8(h, _mm256_setzero_si256()));
 }
 
 #define CYL_SKIP_PACKED_AVX2(NAME, UO, FINE)                                                   \
@@ -170,6 +177,8 @@ CYL_SKIP_TARGET_AVX2 static inline int cyl_skip_none256(__m256i un, __m256i vn, 
                                             UO + 14, -1, -1, -1, -1, -1, -1, -1, -1,           \
                                             UO, UO + 4, UO + 8, UO + 12, UO + 2, UO + 6, UO + 10, \
                                             UO + 14, -1, -1, -1, -1, -1, -1, -1, -1);          \
+        /* the dwords hold pairs 0-3, 8-11, 16-19, 24-27 | 4-7, 12-15, 20-23, 28-31 */          \
+        const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);                      \
         for (; p + 32u <= n; p += 32u) {                                                       \
             const uint8_t *b = u + 4u * (size_t)p;                                             \
             __m256i w0 = _mm256_shuffle_epi8(_mm256_loadu_si256((const __m256i *)(const void *)b), sh);        \
@@ -179,11 +188,11 @@ CYL_SKIP_TARGET_AVX2 static inline int cyl_skip_none256(__m256i un, __m256i vn, 
             __m256i a = _mm256_unpacklo_epi32(w0, w1), c = _mm256_unpacklo_epi32(w2, w3);      \
             __m256i un = _mm256_and_si256(_mm256_srli_epi16(_mm256_unpacklo_epi64(a, c), 4), nib); \
             __m256i vn = _mm256_and_si256(_mm256_srli_epi16(_mm256_unpackhi_epi64(a, c), 4), nib); \
-            if (!cyl_skip_none256(un, vn, map)) {                                              \
-                uint32_t q;                                                                    \
+            __m256i h = cyl_skip_hits256(un, vn, map);                                         \
+            if (!_mm256_testz_si256(h, h)) {                                                   \
+                const unsigned m = cyl_skip_bits256(_mm256_permutevar8x32_epi32(h, order));     \
                 _mm256_zeroupper();                                                            \
-                q = FINE(u, v, map, p, p + 32u);                                               \
-                if (q < p + 32u) return q;                                                     \
+                return p + (uint32_t)__builtin_ctz(m);                                         \
             }                                                                                  \
         }                                                                                      \
         _mm256_zeroupper();                                                                    \
@@ -204,14 +213,15 @@ CYL_SKIP_TARGET_AVX2 static uint32_t cyl_skip_nv12_avx2(const uint8_t *u, const 
         __m256i un = _mm256_packus_epi16(_mm256_and_si256(_mm256_srli_epi16(w0, 4), nib),
                                          _mm256_and_si256(_mm256_srli_epi16(w1, 4), nib));
         __m256i vn = _mm256_packus_epi16(_mm256_srli_epi16(w0, 12), _mm256_srli_epi16(w1, 12));
-        if (!cyl_skip_none256(un, vn, map)) {
-            uint32_t q;
-            _mm256_zeroupper();   /* the SSSE3 code is not VEX-encoded: no transition penalty */
-            q = cyl_skip_nv12_ssse3(u, v, map, p, p + 32u);
-            if (q < p + 32u) return q;
+        __m256i h = cyl_skip_hits256(un, vn, map);
+        if (!_mm256_testz_si256(h, h)) {
+            /* the in-lane packs leave the qwords holding pairs 0-7, 16-23 | 8-15, 24-31 */
+            const unsigned m = cyl_skip_bits256(_mm256_permute4x64_epi64(h, 0xD8));
+            _mm256_zeroupper();
+            return p + (uint32_t)__builtin_ctz(m);
         }
     }
-    _mm256_zeroupper();
+    _mm256_zeroupper();   /* the SSSE3 code is not VEX-encoded: no transition penalty */
     return cyl_skip_nv12_ssse3(u, v, map, p, n);
 }
 
@@ -222,11 +232,11 @@ CYL_SKIP_TARGET_AVX2 static uint32_t cyl_skip_i420_avx2(const uint8_t *u, const 
     for (; p + 32u <= n; p += 32u) {
         __m256i un = _mm256_and_si256(_mm256_srli_epi16(_mm256_loadu_si256((const __m256i *)(const void *)(u + p)), 4), nib);
         __m256i vn = _mm256_and_si256(_mm256_srli_epi16(_mm256_loadu_si256((const __m256i *)(const void *)(v + p)), 4), nib);
-        if (!cyl_skip_none256(un, vn, map)) {
-            uint32_t q;
-            _mm256_zeroupper();   /* the SSSE3 code is not VEX-encoded: no transition penalty */
-            q = cyl_skip_i420_ssse3(u, v, map, p, p + 32u);
-            if (q < p + 32u) return q;
+        __m256i h = cyl_skip_hits256(un, vn, map);
+        if (!_mm256_testz_si256(h, h)) {
+            const unsigned m = cyl_skip_bits256(h);   /* planar: already in pair order */
+            _mm256_zeroupper();
+            return p + (uint32_t)__builtin_ctz(m);
         }
     }
     _mm256_zeroupper();
@@ -381,8 +391,9 @@ CYL_BOX_PACKED(cyl_box_uyvy_avx2, CYL_SKIP_TARGET_AVX2, __m256i, _mm256_set1_epi
  * (cyl_colortable_mask). A pair of another class ends the run there (where runs usually end: no
  * gathers); a pair of class cur means the run's colours leave the box, and the rest of the run
  * takes the exact test by gathers. The box is a subset of the class, so the answer is the exact
- * lookup's in every case; an empty box leaves the whole run to the gathers. PAIR gives pair q's
- * Y0, Y1, U, V. */
+ * lookup's in every case; an empty box leaves the whole run to the gathers. The pair's chroma
+ * entry alone settles most run ends: no bit of class cur there, no pixel of the pair is of cur.
+ * Y0, Y1, U, V: pair q's bytes. */
 #define CYL_EXTEND_AVX2(NAME, BOX, GATHER, Y0, Y1, U, V)                                       \
     CYL_SKIP_TARGET_AVX2 static uint32_t NAME(const cyl_colortable *t, const uint8_t *y,       \
                                               const uint8_t *u, const uint8_t *v, uint32_t p,  \
@@ -390,7 +401,8 @@ CYL_BOX_PACKED(cyl_box_uyvy_avx2, CYL_SKIP_TARGET_AVX2, __m256i, _mm256_set1_epi
     {                                                                                          \
         const uint32_t q = BOX(t, y, u, v, p, n, cur);                                         \
         (void)u; (void)v;                                                                      \
-        if (q >= n || cyl_lowbit[cyl_colortable_mask(t, Y0, U, V)] != cur ||                  \
+        if (q >= n || !((t->uv[U][V] >> cur) & 1u) ||                                          \
+            cyl_lowbit[cyl_colortable_mask(t, Y0, U, V)] != cur ||                             \
             cyl_lowbit[cyl_colortable_mask(t, Y1, U, V)] != cur)                               \
             return q;                                                                          \
         return GATHER(t, y, u, v, q + 1u, n, cur);                                             \
