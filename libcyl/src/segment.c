@@ -173,7 +173,7 @@ typedef struct bg_skip {
 
 /* Background pairs from sample x (even offset from the row's pairs) on: returns the first x' >= x
  * such that every pair in [x, x') has uv == 0 (and x' + 1 < x1 where a pair may be coloured).
- * Short gaps are walked by the scalar test (1 pair); longer ones by the vector skip on the coarse
+ * Short gaps are walked by the scalar test (4 pairs); longer ones by the vector skip on the coarse
  * chroma map, then the scalar test again for at most 8 pairs, since a block bit may be set by
  * another chroma of the block. Where the background's chroma keeps falling in blocks the map
  * cannot rule out, the vector skip costs more than it saves: after two short skips it is off for
@@ -185,7 +185,7 @@ CYL_HOT_INLINE uint32_t skip_background(const cyl_colortable *t, const uint8_t *
     const uint8_t *pu = up + (x / 2u) * cs, *pv = vp + (x / 2u) * cs;
     uint32_t xlim = x1;
     if (sk->fn) {
-        const uint32_t xw = x + 2u < x1 ? x + 2u : x1;
+        const uint32_t xw = x + 8u < x1 ? x + 8u : x1;
         while (x + 1u < xw && uv[pu[0]][pv[0]] == 0) { x += 2u; pu += cs; pv += cs; }
         if (x + 1u < xw) return x;   /* a pair that may be coloured */
         if (x + 1u < x1) {
