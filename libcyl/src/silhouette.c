@@ -54,24 +54,81 @@ static double polygon_radius(double r)
  * and the circle of radius r0 at z0 (above the centroid plane), axis at robot-frame (x, y): the
  * convex hull of the two circles' points, in hull[0 .. k-1] (k returned; 0 if a point is not in
  * front of the camera or the hull is degenerate). */
+/* (x, y) order of two points */
+static int before(const double *a, const double *b)
+{
+    return a[0] < b[0] || (a[0] == b[0] && a[1] < b[1]);
+}
+
+/* The points of a convex polygon given in cyclic order (n points at c) in (x, y) order, into out:
+ * the two chains from its first point in that order to its last are each already in order when the
+ * polygon is convex, so one merge sorts them. */
+static void convex_sorted(const double (*c)[2], int n, double (*out)[2])
+{
+    int i, lo = 0, hi = 0, f, b, k = 0;
+    for (i = 1; i < n; i++) {
+        if (before(c[i], c[lo])) lo = i;
+        if (before(c[hi], c[i])) hi = i;
+    }
+    /* forward chain lo, lo + 1, ..., hi; backward chain lo - 1, lo - 2, ..., hi + 1 (cyclic) */
+    f = lo;
+    b = (lo + n - 1) % n;
+    {
+        const int nf = (hi - lo + n) % n + 1, nb = n - nf;
+        int tf = 0, tb = 0;
+        while (tf < nf || tb < nb) {
+            if (tb >= nb || (tf < nf && !before(c[b], c[f]))) {
+                out[k][0] = c[f][0]; out[k][1] = c[f][1];
+                if (++f == n) f = 0;
+                tf++;
+            } else {
+                out[k][0] = c[b][0]; out[k][1] = c[b][1];
+                b = (b == 0 ? n : b) - 1;
+                tb++;
+            }
+            k++;
+        }
+    }
+}
+
+/* The image (normalised coordinates) of the frustum between the circle of radius r1 at height z1
+ * and the circle of radius r0 at z0 (above the centroid plane), axis at robot-frame (x, y): the
+ * convex hull of the two circles' points, in hull[0 .. k-1] (k returned; 0 if a point is not in
+ * front of the camera or the hull is degenerate). */
 static int frustum_hull(const mount *mt, double x_m, double y_m, double z1, double r1, double z0, double r0,
                         double hull[NPTS + 1][2])
 {
-    double p[NPTS][2];
+    double p[NPTS][2];   /* the circles' points (top then bottom), then all in (x, y) order */
     int i, j, k = 0, lower;
     {   /* the circles' points by rotation: two sines per call instead of two per point */
         const double da = 6.283185307179586 / CYL_SILHOUETTE_POINTS, cd = cos(da), sd = sin(da);
         double ca = 1.0, sa = 0.0;
         for (i = 0; i < CYL_SILHOUETTE_POINTS; i++) {
             const double t = ca * cd - sa * sd;
-            if (!to_normalised(mt, x_m + r1 * ca, y_m + r1 * sa, z1, &p[2 * i][0], &p[2 * i][1]) ||
-                !to_normalised(mt, x_m + r0 * ca, y_m + r0 * sa, z0, &p[2 * i + 1][0], &p[2 * i + 1][1]))
+            double *q1 = p[i], *q0 = p[CYL_SILHOUETTE_POINTS + i];
+            if (!to_normalised(mt, x_m + r1 * ca, y_m + r1 * sa, z1, &q1[0], &q1[1]) ||
+                !to_normalised(mt, x_m + r0 * ca, y_m + r0 * sa, z0, &q0[0], &q0[1]))
                 return 0;
             sa = sa * cd + ca * sd;
             ca = t;
         }
     }
-    /* sort by (x, y): insertion sort, NPTS is small */
+    /* sort by (x, y): each circle's image is convex with its points in cyclic order, so it comes
+     * out in order from one merge of its two chains (into hull, free until the chain below), and
+     * one more merge orders both; the insertion sort after them only settles what rounding left
+     * out of order (one comparison a point when there is nothing to move) */
+    convex_sorted((const double (*)[2])p, CYL_SILHOUETTE_POINTS, hull);
+    convex_sorted((const double (*)[2])(p + CYL_SILHOUETTE_POINTS), CYL_SILHOUETTE_POINTS, hull + CYL_SILHOUETTE_POINTS);
+    {
+        const double (*s1)[2] = (const double (*)[2])hull, (*s0)[2] = (const double (*)[2])(hull + CYL_SILHOUETTE_POINTS);
+        int a = 0, b = 0;
+        for (i = 0; i < NPTS; i++) {
+            const double *q = (b >= CYL_SILHOUETTE_POINTS ||
+                               (a < CYL_SILHOUETTE_POINTS && !before(s0[b], s1[a]))) ? s1[a++] : s0[b++];
+            p[i][0] = q[0];
+            p[i][1] = q[1];
+        }
+    }
     for (i = 1; i < NPTS; i++) {
         double t0 = p[i][0], t1 = p[i][1];
         for (j = i - 1; j >= 0 && (p[j][0] > t0 || (p[j][0] == t0 && p[j][1] > t1)); j--) {
