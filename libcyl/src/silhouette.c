@@ -50,10 +50,6 @@ static double polygon_radius(double r)
     return r * sqrt(6.283185307179586 / (CYL_SILHOUETTE_POINTS * sin(6.283185307179586 / CYL_SILHOUETTE_POINTS)));
 }
 
-/* The image (normalised coordinates) of the frustum between the circle of radius r1 at height z1
- * and the circle of radius r0 at z0 (above the centroid plane), axis at robot-frame (x, y): the
- * convex hull of the two circles' points, in hull[0 .. k-1] (k returned; 0 if a point is not in
- * front of the camera or the hull is degenerate). */
 /* (x, y) order of two points */
 static int before(const double *a, const double *b)
 {
@@ -130,13 +126,13 @@ static int frustum_hull(const mount *mt, double x_m, double y_m, double z1, doub
         }
     }
     for (i = 1; i < NPTS; i++) {
-        double t0 = p[i][0], t1 = p[i][1];
-        for (j = i - 1; j >= 0 && (p[j][0] > t0 || (p[j][0] == t0 && p[j][1] > t1)); j--) {
+        const double t[2] = {p[i][0], p[i][1]};
+        for (j = i - 1; j >= 0 && before(t, p[j]); j--) {
             p[j + 1][0] = p[j][0];
             p[j + 1][1] = p[j][1];
         }
-        p[j + 1][0] = t0;
-        p[j + 1][1] = t1;
+        p[j + 1][0] = t[0];
+        p[j + 1][1] = t[1];
     }
     /* Andrew's monotone chain: lower hull, then upper hull (every hull comes out with the same
      * orientation, so areas of hulls and of their clipped parts add and subtract) */
