@@ -238,6 +238,9 @@ class Params:
                                    # (from distinct steps) agree; until then they wait in a
                                    # candidate buffer (1: at once)
     init_window: int = 50          # steps a candidate waits for its next view before it is dropped
+    reassoc: int = 0               # unknown association: at most this many batch re-association
+                                   # passes after the batch solve (pairings made again at the whole
+                                   # run's estimate, duplicates merged; _reassociate); 0: none
     merge_every: int = 0           # unknown association: every N steps, two landmarks of a class
                                    # never seen in one frame whose difference is inside the gate
                                    # (joint marginal) become one; 0: never
@@ -363,6 +366,8 @@ class Slam:
                                    gtsam.noiseModel.Diagonal.Sigmas(np.array(p.prior_sigmas)))
         graph.add(f)
         new_f.add(f)
+        base_f = [f]
+        frames = []
         new_v.insert(X(0), gtsam.Pose2(*start))
         use_calib = p.calib_states and p.fixed_cov is None
         if use_calib:
@@ -372,6 +377,8 @@ class Slam:
             graph.add(f)
             new_f.add(f)
             new_v.insert(CALIB, np.zeros(8))
+        if p.reassoc and mode == "unknown" and (use_calib or not p.batch):
+            raise ValueError("batch re-association (--reassoc) needs the batch pass and no calibration states")
         rbm = None
         if p.calib_model not in ("exact", "linear"):
             raise ValueError(f"unknown calibration model {p.calib_model!r}")
@@ -462,6 +469,7 @@ class Slam:
                 if s.odom is None:
                     raise ValueError(f"step {i} has no odometry")
                 f = gtsam.BetweenFactorPose2(X(i - 1), X(i), gtsam.Pose2(*s.odom), self._odom_noise(s.odom_cov))
+                base_f.append(f)
                 graph.add(f)
                 new_f.add(f)
                 cur = compose(cur, s.odom)
@@ -503,6 +511,7 @@ class Slam:
                     (o.cov - o.cov_frame + p.fixed_frame_cov
                      if use_calib and p.fixed_frame_cov is not None and o.cov_frame is not None else o.cov)
                     for o in usable]
+            frames.append((i, usable, covs))
             if mode == "known":
                 # identities are given: no gating, and a landmark first seen creates it
                 targets = [id_to_lm.get(o.lm_id, -1) for o in usable]
@@ -559,12 +568,16 @@ class Slam:
             opt = gtsam.LevenbergMarquardtOptimizer(graph, est, lp)
             est = opt.optimize()
             st["batch_iterations"] = opt.iterations()
+        removed = set()
+        if p.reassoc and mode == "unknown":
+            graph, est, assoc, removed = self._reassociate(frames, base_f, est, graph, assoc, lm_class,
+                                                           merged_into, gate, st)
         t_batch = time.perf_counter() - t0 - t_isam
         poses = _poses(est, n)
         # a merged landmark is the one it was merged into: results list each once
-        keep = [j for j in range(len(lms_init)) if j not in merged_into]
+        keep = [j for j in range(len(lms_init)) if j not in merged_into and j not in removed]
         index = {j: x for x, j in enumerate(keep)}
-        root = {j: index[_root(merged_into, j)] for j in range(len(lms_init))}
+        root = {j: index[_root(merged_into, j)] for j in range(len(lms_init)) if _root(merged_into, j) in index}
         assoc = [(i, o, root[j]) for (i, o, j) in assoc]
         lm_class = [lm_class[j] for j in keep]
         lm_ids = [lm_ids[j] for j in keep]
@@ -592,6 +605,112 @@ class Slam:
         return Result(poses=poses, pose_cov=pose_cov, isam_poses=isam_poses, lms=lms,
                       lm_cov=lm_cov, lm_class=lm_class, lm_ids=lm_ids, assoc=assoc, stats=st,
                       info=info, lm_keys=lm_keys)
+
+    def _reassociate(self, frames, base_f, est, graph, assoc, lm_class, merged_into, gate, st):
+        """Batch re-association (`reassoc` passes at most): every usable observation of every frame
+        is paired again, against the landmarks at the batch estimate, with the frame's Hungarian
+        assignment of individual distances (d2 <= chi2_2(gate_p), d2 from the observation's
+        covariance and the landmark's marginal at the estimated pose, at most one observation a
+        landmark; observations the online pass dropped as ambiguous or imprecise take part too).
+        Then two landmarks of a class that no frame pairs together and whose difference passes the
+        same gate under their marginals become one (the closest pairs first, each landmark in one
+        merge a pass); a landmark no observation pairs with is removed. The graph is rebuilt from
+        the odometry and these pairings and solved again (Levenberg-Marquardt from the last
+        estimate). Passes stop when no pairing changed, or when a pass gives the pairings of the pass
+        before the last (a few pairings flipping back and forth). Online, a pairing is made once with the
+        uncertain pose of that moment; here each is made again with the whole run's estimate.
+        Returns the graph, the estimate, the pairings and the removed landmarks."""
+        p = self.p
+        lms = sorted({_root(merged_into, j) for (_, _, j) in assoc})
+        cur = {(i, id(o)): _root(merged_into, j) for (i, o, j) in assoc}
+        cnt = {j: 1 for j in lms}
+        st["reassoc_changed"] = []
+        st["reassoc_merges"] = 0
+        before = None                        # the pairings of the pass before the last
+        for _ in range(p.reassoc):
+            marg = gtsam.Marginals(graph, est)
+            P = {j: marg.marginalCovariance(L(j)) for j in lms}
+            pos = {j: np.array(est.atPoint2(L(j))) for j in lms}
+            new = []                         # (step, observation, covariance, landmark)
+            for (i, usable, covs) in frames:
+                pe = est.atPose2(X(i))
+                pose = np.array([pe.x(), pe.y(), pe.theta()])
+                cols = [j for j in lms if any(lm_class[j] == o.cls for o in usable)]
+                if not cols:
+                    continue
+                cost = np.full((len(usable), len(cols) + len(usable)), np.inf)
+                for a, (o, R) in enumerate(zip(usable, covs)):
+                    z = np.array([o.range_m, o.bearing_rad])
+                    for c, j in enumerate(cols):
+                        if lm_class[j] != o.cls:
+                            continue
+                        h, H = predict_rb(pose, pos[j])
+                        nu = z - h
+                        nu[1] = wrap(nu[1])
+                        Hl = H[:, 3:5]
+                        d2 = float(nu @ np.linalg.solve(Hl @ P[j] @ Hl.T + R, nu))
+                        if d2 <= gate:
+                            cost[a, c] = d2
+                    cost[a, len(cols) + a] = gate
+                for a, c in enumerate(hungarian(np.where(np.isfinite(cost), cost, 1e9))):
+                    if c < len(cols) and np.isfinite(cost[a, c]):
+                        new.append((i, usable[a], covs[a], cols[c]))
+            # duplicates: never paired in one frame, and compatible
+            together = set()
+            per_step = {}
+            for (i, _, _, j) in new:
+                per_step.setdefault(i, set()).add(j)
+            for js in per_step.values():
+                together.update((x, y) for x in js for y in js if x < y)
+            used = sorted({j for (_, _, _, j) in new})
+            pairs = []
+            for k, x in enumerate(used):
+                for y in used[k + 1:]:
+                    if lm_class[x] == lm_class[y] and (x, y) not in together:
+                        dv = pos[x] - pos[y]
+                        d2 = float(dv @ np.linalg.solve(P[x] + P[y], dv))
+                        if d2 <= gate:
+                            pairs.append((d2, x, y))
+            into, busy = {}, set()
+            for _, x, y in sorted(pairs):
+                if x not in busy and y not in busy:
+                    busy.update((x, y))
+                    into[y] = x
+            st["reassoc_merges"] += len(into)
+            new = [(i, o, c, into.get(j, j)) for (i, o, c, j) in new]
+            cnt = {}
+            for (_, _, _, j) in new:
+                cnt[j] = cnt.get(j, 0) + 1
+            lms = sorted(cnt)
+            now = {(i, id(o)): j for (i, o, _, j) in new}
+            changed = sum(1 for key in cur.keys() | now.keys() if cur.get(key) != now.get(key))
+            st["reassoc_changed"].append(changed)
+            # a 2-cycle (a few pairings flipping back and forth between passes) ends the passes too
+            cycle = changed > 0 and now == before
+            before, cur = cur, now
+            graph = gtsam.NonlinearFactorGraph()
+            for f in base_f:
+                graph.add(f)
+            for (i, o, c, j) in new:
+                graph.add(gtsam.BearingRangeFactor2D(X(i), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
+                                                     self._obs_noise(c)))
+            v = gtsam.Values()
+            for key in est.keys():
+                sym = gtsam.Symbol(key)
+                if sym.chr() == ord("x"):
+                    v.insert(key, est.atPose2(key))
+                elif sym.index() in cnt:
+                    v.insert(key, est.atPoint2(key))
+            lp = gtsam.LevenbergMarquardtParams()
+            lp.setMaxIterations(100)
+            est = gtsam.LevenbergMarquardtOptimizer(graph, v, lp).optimize()
+            assoc = [(i, o, j) for (i, o, _, j) in new]
+            if changed == 0 or cycle:
+                st["reassoc_cycle"] = cycle
+                break
+        removed = {j for j in range(len(lm_class)) if j not in cnt}
+        merged_into.clear()                  # every pairing names its landmark itself now
+        return graph, est, assoc, removed
 
     def _jcbb(self, gated, covs, cands, Sig, nobs):
         """Joint compatibility branch and bound (Neira and Tardos 2001): among the hypotheses that

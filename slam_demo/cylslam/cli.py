@@ -45,6 +45,16 @@ class Progress:
         sys.stderr.flush()
 
 
+def _reassoc_conflict(args):
+    """--reassoc with an option it cannot run with: the message, True."""
+    n = getattr(args, "reassoc", 0)
+    why = ("must be >= 0" if n < 0 else "needs the batch pass (not --no-batch)" if n and args.no_batch else
+           "cannot run with --calib-states" if n and getattr(args, "calib_states", False) else None)
+    if why:
+        print(f"cylslam: error: --reassoc {n}: {why}", file=sys.stderr)
+    return why is not None
+
+
 def _params(args, **over):
     from .backend import Params
     p = Params(assoc=args.assoc, conf_min=args.conf_min, gate_p=args.gate, new_p=args.new_gate,
@@ -52,6 +62,7 @@ def _params(args, **over):
                anchor=args.anchor, batch=not args.no_batch, reject_flags=int(args.reject_flags, 0),
                exclusion=getattr(args, "exclusion", False), joint=getattr(args, "assoc_method", "") == "jcbb",
                merge_every=getattr(args, "merge_every", 0), init_views=getattr(args, "init_views", 1),
+               reassoc=getattr(args, "reassoc", 0),
                calib_states=getattr(args, "calib_states", False),
                lm_bias=getattr(args, "lm_bias", "auto"),
                calib_model=getattr(args, "calib_model", "linear"),
@@ -342,6 +353,10 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
     g.add_argument("--merge-every", type=int, default=0, metavar="N",
                    help="unknown association: every N steps, merge two landmarks of a class never "
                         "seen in one frame whose difference passes the gate (default 0: never)")
+    g.add_argument("--reassoc", type=int, default=0, metavar="N",
+                   help="unknown association: after the batch solve, pair every observation again at "
+                        "the whole run's estimate, merge duplicate landmarks and solve again, up to N "
+                        "passes or until no pairing changes (default 0: none; not with --calib-states)")
     g.add_argument("--cand-radius", type=float, default=2.0,
                    help="m, Euclidean pre-selection of association candidates, plus 3 sigma of "
                         "the observation (default %(default)s)")
@@ -420,6 +435,8 @@ def cmd_run(args):
         return EXIT_INPUT
     for n in ds.notes:
         print(f"note: {n}")
+    if _reassoc_conflict(args):
+        return EXIT_USAGE
     if args.fixed_cov == "frame-grid" and not args.calib_states:
         print("cylslam: error: --fixed-cov frame-grid needs --calib-states", file=sys.stderr)
         return EXIT_USAGE
@@ -473,6 +490,8 @@ def cmd_mrclam(args):
     robots = [1, 2, 3, 4, 5] if args.robot == "all" else [int(args.robot)]
     rows = []
     model = None
+    if _reassoc_conflict(args):
+        return EXIT_USAGE
     if args.noise != "learned" and args.noise_model is not None:
         print("cylslam: error: --noise-model needs --noise learned", file=sys.stderr)
         return EXIT_USAGE
@@ -546,7 +565,9 @@ def cmd_mrclam(args):
     agg["parameters"] = {"assoc": args.assoc, "noise": args.noise,
                          "noise_model": args.noise_model if model else None, "robust": args.robust,
                          "robust_k": args.huber_k if args.robust != "none" else None,
-                         "odom_scale": args.odom_scale, "gate": args.gate, "new_gate": args.new_gate}
+                         "odom_scale": args.odom_scale, "gate": args.gate, "new_gate": args.new_gate,
+                         "exclusion": args.exclusion, "assoc_method": args.assoc_method,
+                         "reassoc": args.reassoc}
     if args.multi:
         agg.update(multi_robot(args, datasets, robots))
         if args.check_rmse is not None:

@@ -318,3 +318,69 @@ def test_views_that_wait_in_the_buffer_still_count_as_seen_together():
     res = Spy(backend.Params(assoc="unknown", init_views=2, merge_every=1)).run(ds)
     assert len(res.lms) == 2 and [(k, j) for (k, _, j) in res.assoc] == [(0, 0), (1, 0), (0, 1), (3, 1), (4, 0)]
     assert (0, 1) in got[-1]
+
+
+def test_batch_reassociation_mends_a_swapped_frame_and_merges_a_duplicate():
+    """Two posts 0.8 m apart at 3 m, both seen from six poses along x with precise odometry. The
+    pairings handed to the re-association are wrong in two ways: frame 3's two observations are
+    swapped, and frame 5's view of A went to a third landmark (a duplicate of A). The batch solve of
+    those pairings is distorted (most in landmark 0, which holds A's views and frame 3's view of B);
+    re-paired at that estimate, the passes end with every observation of a post on one landmark (A's
+    on the undistorted duplicate: landmark 0 is left with none and removed), and the map within 1 cm."""
+    A, B = np.array([3.0, 0.4]), np.array([3.0, -0.4])
+    cov = np.diag([0.05 ** 2, 0.01 ** 2])
+    slam = backend.Slam(backend.Params(assoc="unknown", robust="cauchy", huber_k=2.3, reassoc=10))
+    base = [gtsam.PriorFactorPose2(X(0), gtsam.Pose2(), gtsam.noiseModel.Diagonal.Sigmas(np.array([1e-3, 1e-3, 1e-4])))]
+    graph = gtsam.NonlinearFactorGraph()
+    graph.add(base[0])
+    v = gtsam.Values()
+    frames, assoc = [], []
+    odo = gtsam.noiseModel.Diagonal.Sigmas(np.array([1e-3, 1e-3, 1e-3]))
+    for i in range(6):
+        pose = np.array([0.1 * i, 0.0, 0.0])
+        v.insert(X(i), gtsam.Pose2(*pose))
+        if i:
+            f = gtsam.BetweenFactorPose2(X(i - 1), X(i), gtsam.Pose2(0.1, 0.0, 0.0), odo)
+            base.append(f)
+            graph.add(f)
+        za, zb = _obs(pose, A, cov), _obs(pose, B, cov)
+        frames.append((i, [za, zb], [cov, cov]))
+        ja, jb = {3: (1, 0), 5: (2, 1)}.get(i, (0, 1))
+        for o, j in ((za, ja), (zb, jb)):
+            assoc.append((i, o, j))
+            graph.add(gtsam.BearingRangeFactor2D(X(i), L(j), gtsam.Rot2(o.bearing_rad), o.range_m, slam._obs_noise(cov)))
+    for j, p in enumerate((A, B, A + [0.05, 0.0])):
+        v.insert(L(j), gtsam.Point2(*p))
+    est = gtsam.LevenbergMarquardtOptimizer(graph, v).optimize()
+    assert np.linalg.norm(np.asarray(est.atPoint2(L(2))) - A) > 0.0   # a duplicate, estimated apart
+    st = {}
+    graph2, est2, assoc2, removed = slam._reassociate(frames, base, est, graph, assoc, ["post"] * 3, {},
+                                                      backend.chi2_2dof(0.99), st)
+    post = {id(o): k % 2 for k, (_, o, _) in enumerate(assoc)}      # 0: A, 1: B
+    lm_of = {p_: {j for (_, o, j) in assoc2 if post[id(o)] == p_} for p_ in (0, 1)}
+    assert len(assoc2) == 12 and all(len(js) == 1 for js in lm_of.values())   # each post on one landmark
+    ja, jb = lm_of[0].pop(), lm_of[1].pop()
+    assert ja != jb and removed == {0, 1, 2} - {ja, jb} and len(removed) == 1
+    assert st["reassoc_changed"][-1] == 0 and len(st["reassoc_changed"]) >= 2
+    assert np.allclose(est2.atPoint2(L(ja)), A, atol=0.01) and np.allclose(est2.atPoint2(L(jb)), B, atol=0.01)
+    assert graph2.size() == len(base) + 12
+
+
+def test_reassociation_merges_a_duplicate_in_a_run():
+    """The drive of the duplicate test above, with --reassoc instead of --merge-every: one landmark,
+    every observation on it, the pose pulled back."""
+    A = np.array([3.0, 0.0])
+    cov = np.diag([0.01 ** 2, 0.003 ** 2])
+    steps = [Step(t=0, seq=0, truth=np.zeros(3), obs=[_obs(np.zeros(3), A, cov)]),
+             Step(t=1, seq=1, odom=np.array([0.3, 0.0, 0.0]), odom_cov=np.diag([0.3 ** 2, 1e-6, 1e-6]),
+                  truth=np.zeros(3), obs=[_obs(np.zeros(3), A, cov)]),
+             Step(t=2, seq=2, odom=np.zeros(3), odom_cov=np.diag([1e-6] * 3), truth=np.zeros(3),
+                  obs=[_obs(np.zeros(3), A, cov)])]
+    ds = Dataset(name="duplicate", steps=steps, truth_landmarks={0: (*A, "post")})
+    res = backend.Slam(backend.Params(assoc="unknown", cand_radius=0.05, reassoc=5)).run(ds)
+    assert res.stats["new_landmarks"] == 2 and res.stats["reassoc_merges"] == 1
+    assert len(res.lms) == 1 and [j for (_, _, j) in res.assoc] == [0, 0, 0]
+    assert np.allclose(res.lms[0], A, atol=1e-3) and np.allclose(res.poses[:, 0], 0.0, atol=2e-3)
+    assert metrics.evaluate(ds, res)["association_errors"] == 0
+    with pytest.raises(ValueError, match="re-association"):
+        backend.Slam(backend.Params(assoc="unknown", reassoc=5, batch=False)).run(ds)

@@ -180,3 +180,14 @@ def test_version_is_the_librarys():
     assert cylslam.__version__ == v
     r = _cli("--version")
     assert r.returncode == 0 and r.stdout.strip() == f"cylslam {v}"
+
+
+@pytest.mark.parametrize("extra,why", [(["--reassoc", "-1"], "must be >= 0"),
+                                       (["--reassoc", "3", "--no-batch"], "needs the batch pass"),
+                                       (["--reassoc", "3", "--calib-states"], "cannot run with --calib-states")])
+def test_reassoc_conflicts_are_usage_errors(tmp_path, extra, why):
+    r = subprocess.run([sys.executable, "-m", "cylslam", "run", os.path.join(FIXTURES, "synth_short.jsonl"),
+                        "--no-plot", "--out", str(tmp_path / "o")] + extra,
+                       capture_output=True, text=True, env=ENV)
+    assert r.returncode == 2 and why in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "o").exists()        # refused before any work
