@@ -4,7 +4,7 @@
 #   make slam-test     the slam_demo pytest suite (also part of `make test`)
 #   make slam-synth    synthetic log -> SLAM -> plots, metrics, acceptance check (out/slam/synth)
 #   make mrclam        MRCLAM Dataset 7, all 5 robots: the learned noise model with known and unknown
-#                      association (--exclusion --reassoc 20) and one map of all robots; the fixed
+#                      association (--exclusion --reassoc 20 --starts 1,0.5,2) and one map of all robots; the fixed
 #                      model's known association, checked (out/slam/mrclam*); last line JSON
 #   make mrclam-noise  learn the noise model from Dataset 7's truth, with the held-out robot check
 #   make victoria      gtsam's Victoria Park file (out/slam/victoria)
@@ -47,7 +47,8 @@ mrclam: $(VENV)/.stamp
 	  --summary-out $(SLAM_OUT)/mrclam-fixed-known.json --check-rmse 0.15 --check-time 30
 	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc known --noise learned --multi \
 	  --out $(SLAM_OUT)/mrclam-known --summary-out $(SLAM_OUT)/mrclam-known.json
-	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc unknown --noise learned --exclusion --reassoc 20 \
+	$(CYLSLAM) mrclam --dir $(MRCLAM_DIR) --robot all --assoc unknown --noise learned \
+	  --exclusion --reassoc 20 --starts 1,0.5,2 \
 	  --out $(SLAM_OUT)/mrclam-unknown --summary-out $(SLAM_OUT)/mrclam-unknown.json
 	@$(VENV_PY) scripts/mrclam_summary.py $(SLAM_OUT)
 

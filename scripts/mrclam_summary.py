@@ -56,7 +56,7 @@ def combine(runs):
         "parameters": {
             "known": {**k["parameters"], "source": learned},
             "unknown": {**u["parameters"], "source": learned + "; gates are chi-square probabilities; "
-                        "exclusion and reassoc (a cap: passes stop when no pairing changes) chosen on "
+                        "exclusion, reassoc (a cap: passes stop when no pairing changes) and starts chosen on "
                         "Dataset 7 robots 1, 3, 5 (slam_demo/README.md)"},
             "fixed-known": {**f["parameters"], "source": "the reader's fixed models (cylslam/mrclam.py), Huber 1.345"},
         },

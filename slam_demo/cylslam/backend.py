@@ -241,6 +241,10 @@ class Params:
     reassoc: int = 0               # unknown association: at most this many batch re-association
                                    # passes after the batch solve (pairings made again at the whole
                                    # run's estimate, duplicates merged; _reassociate); 0: none
+    starts: tuple = (1.0,)         # unknown association with reassoc: one online pass per entry,
+                                   # its odometry sigmas (for the gating of that pass only) times
+                                   # the entry; after re-association under the nominal sigmas the
+                                   # run of least penalised cost is kept (Slam.run)
     merge_every: int = 0           # unknown association: every N steps, two landmarks of a class
                                    # never seen in one frame whose difference is inside the gate
                                    # (joint marginal) become one; 0: never
@@ -339,6 +343,36 @@ class Slam:
         return np.maximum(o.bias_var_px2, 1e-12)
 
     def run(self, ds) -> Result:
+        """SLAM on a data set. With unknown association, batch re-association and several `starts`,
+        one run per start; each run's pairings, re-associated and solved under the nominal odometry
+        sigmas, are scored by the negative log-likelihood of that solution: the graph's error, the
+        cost of the "no landmark" option (chi2_2(gate_p) / 2) for each observation left unpaired,
+        and a BIC penalty of ln(pairings) for each landmark (2 coordinates, half ln n each); the
+        least is kept. Online association is greedy: a pairing made with the pose as uncertain as it
+        was at that step is not undone, and on clustered landmarks which pairing the gate lets
+        through depends on the odometry's sigmas; the whole-run likelihood, not the gate, decides
+        between the outcomes."""
+        p = self.p
+        if not p.starts or any(not (x > 0) for x in p.starts):
+            raise ValueError(f"starts: odometry sigma scales must be > 0, got {p.starts!r}")
+        if (len(p.starts) > 1 or p.starts[0] != 1.0) and not p.reassoc:
+            raise ValueError("several starts need batch re-association (--reassoc), which scores them")
+        t0 = time.perf_counter()
+        best = self._run(ds, p.starts[0])
+        if len(p.starts) == 1 or best.stats["association"] != "unknown":
+            return best
+        tried = [(p.starts[0], best.stats["assoc_cost"], len(best.lms))]
+        for scale in p.starts[1:]:
+            res = self._run(ds, scale)
+            tried.append((scale, res.stats["assoc_cost"], len(res.lms)))
+            if res.stats["assoc_cost"] < best.stats["assoc_cost"]:
+                best = res
+        best.stats["starts"] = [{"odom_sigma_scale": x, "cost": round(c, 2), "landmarks": m} for x, c, m in tried]
+        best.stats["start_chosen"] = best.stats["odom_sigma_scale"]
+        best.stats["t_total_s"] = round(time.perf_counter() - t0, 3)
+        return best
+
+    def _run(self, ds, scale) -> Result:
         p = self.p
         t0 = time.perf_counter()
         mode = p.assoc
@@ -470,6 +504,9 @@ class Slam:
                     raise ValueError(f"step {i} has no odometry")
                 f = gtsam.BetweenFactorPose2(X(i - 1), X(i), gtsam.Pose2(*s.odom), self._odom_noise(s.odom_cov))
                 base_f.append(f)
+                if scale != 1.0:             # this pass's gating only: the re-association's graph has f
+                    f = gtsam.BetweenFactorPose2(X(i - 1), X(i), gtsam.Pose2(*s.odom),
+                                                 self._odom_noise(np.asarray(s.odom_cov) * scale * scale))
                 graph.add(f)
                 new_f.add(f)
                 cur = compose(cur, s.odom)
@@ -571,7 +608,11 @@ class Slam:
         removed = set()
         if p.reassoc and mode == "unknown":
             graph, est, assoc, removed = self._reassociate(frames, base_f, est, graph, assoc, lm_class,
-                                                           merged_into, gate, st)
+                                                           merged_into, gate, st, rebuild=scale != 1.0)
+            n_frames_obs = sum(len(u) for _, u, _ in frames)
+            st["assoc_cost"] = (graph.error(est) + (n_frames_obs - len(assoc)) * gate / 2
+                                + (len(lm_class) - len(removed)) * math.log(max(len(assoc), 2)))
+        st["odom_sigma_scale"] = scale
         t_batch = time.perf_counter() - t0 - t_isam
         poses = _poses(est, n)
         # a merged landmark is the one it was merged into: results list each once
@@ -606,7 +647,7 @@ class Slam:
                       lm_cov=lm_cov, lm_class=lm_class, lm_ids=lm_ids, assoc=assoc, stats=st,
                       info=info, lm_keys=lm_keys)
 
-    def _reassociate(self, frames, base_f, est, graph, assoc, lm_class, merged_into, gate, st):
+    def _reassociate(self, frames, base_f, est, graph, assoc, lm_class, merged_into, gate, st, rebuild=False):
         """Batch re-association (`reassoc` passes at most): every usable observation of every frame
         is paired again, against the landmarks at the batch estimate, with the frame's Hungarian
         assignment of individual distances (d2 <= chi2_2(gate_p), d2 from the observation's
@@ -619,8 +660,27 @@ class Slam:
         estimate). Passes stop when no pairing changed, or when a pass gives the pairings of the pass
         before the last (a few pairings flipping back and forth). Online, a pairing is made once with the
         uncertain pose of that moment; here each is made again with the whole run's estimate.
-        Returns the graph, the estimate, the pairings and the removed landmarks."""
+        With `rebuild` (an online pass gated with other odometry sigmas than `base_f`'s) the
+        graph is first rebuilt from `base_f` and the pairings and solved. Returns the graph, the
+        estimate, the pairings and the removed landmarks."""
         p = self.p
+        if rebuild:
+            cov_of = {id(o): c for (_, u, cs) in frames for o, c in zip(u, cs)}
+            graph = gtsam.NonlinearFactorGraph()
+            for f in base_f:
+                graph.add(f)
+            for (i, o, j) in assoc:
+                graph.add(gtsam.BearingRangeFactor2D(X(i), L(_root(merged_into, j)), gtsam.Rot2(o.bearing_rad),
+                                                     o.range_m, self._obs_noise(cov_of[id(o)])))
+            v = gtsam.Values()
+            used = {_root(merged_into, j) for (_, _, j) in assoc}
+            for key in est.keys():
+                sym = gtsam.Symbol(key)
+                if sym.chr() == ord("x"):
+                    v.insert(key, est.atPose2(key))
+                elif sym.index() in used:
+                    v.insert(key, est.atPoint2(key))
+            est = gtsam.LevenbergMarquardtOptimizer(graph, v).optimize()
         lms = sorted({_root(merged_into, j) for (_, _, j) in assoc})
         cur = {(i, id(o)): _root(merged_into, j) for (i, o, j) in assoc}
         cnt = {j: 1 for j in lms}

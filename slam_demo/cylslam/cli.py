@@ -45,9 +45,22 @@ class Progress:
         sys.stderr.flush()
 
 
+def _scales(text):
+    try:
+        v = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: comma-separated numbers expected")
+    if not v or any(not (x > 0 and math.isfinite(x)) for x in v):
+        raise argparse.ArgumentTypeError(f"{text!r}: every scale must be a finite number > 0")
+    return v
+
+
 def _reassoc_conflict(args):
     """--reassoc with an option it cannot run with: the message, True."""
     n = getattr(args, "reassoc", 0)
+    if getattr(args, "starts", None) and args.starts != (1.0,) and not n:
+        print("cylslam: error: --starts needs --reassoc (the re-association scores the passes)", file=sys.stderr)
+        return True
     why = ("must be >= 0" if n < 0 else "needs the batch pass (not --no-batch)" if n and args.no_batch else
            "cannot run with --calib-states" if n and getattr(args, "calib_states", False) else None)
     if why:
@@ -62,7 +75,7 @@ def _params(args, **over):
                anchor=args.anchor, batch=not args.no_batch, reject_flags=int(args.reject_flags, 0),
                exclusion=getattr(args, "exclusion", False), joint=getattr(args, "assoc_method", "") == "jcbb",
                merge_every=getattr(args, "merge_every", 0), init_views=getattr(args, "init_views", 1),
-               reassoc=getattr(args, "reassoc", 0),
+               reassoc=getattr(args, "reassoc", 0), starts=tuple(getattr(args, "starts", None) or (1.0,)),
                calib_states=getattr(args, "calib_states", False),
                lm_bias=getattr(args, "lm_bias", "auto"),
                calib_model=getattr(args, "calib_model", "linear"),
@@ -357,6 +370,11 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
                    help="unknown association: after the batch solve, pair every observation again at "
                         "the whole run's estimate, merge duplicate landmarks and solve again, up to N "
                         "passes or until no pairing changes (default 0: none; not with --calib-states)")
+    g.add_argument("--starts", type=_scales, default=None, metavar="S1,S2,...",
+                   help="unknown association with --reassoc: one online pass per value, its odometry "
+                        "sigmas times the value for its gating only; after re-association under the "
+                        "nominal sigmas the pass whose solution has the least penalised negative "
+                        "log-likelihood is kept (default: 1, one pass)")
     g.add_argument("--cand-radius", type=float, default=2.0,
                    help="m, Euclidean pre-selection of association candidates, plus 3 sigma of "
                         "the observation (default %(default)s)")
@@ -567,7 +585,7 @@ def cmd_mrclam(args):
                          "robust_k": args.huber_k if args.robust != "none" else None,
                          "odom_scale": args.odom_scale, "gate": args.gate, "new_gate": args.new_gate,
                          "exclusion": args.exclusion, "assoc_method": args.assoc_method,
-                         "reassoc": args.reassoc}
+                         "reassoc": args.reassoc, "starts": list(args.starts or (1.0,))}
     if args.multi:
         agg.update(multi_robot(args, datasets, robots))
         if args.check_rmse is not None:

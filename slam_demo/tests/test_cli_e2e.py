@@ -184,7 +184,8 @@ def test_version_is_the_librarys():
 
 @pytest.mark.parametrize("extra,why", [(["--reassoc", "-1"], "must be >= 0"),
                                        (["--reassoc", "3", "--no-batch"], "needs the batch pass"),
-                                       (["--reassoc", "3", "--calib-states"], "cannot run with --calib-states")])
+                                       (["--reassoc", "3", "--calib-states"], "cannot run with --calib-states"),
+                                       (["--starts", "1,0.5"], "--starts needs --reassoc")])
 def test_reassoc_conflicts_are_usage_errors(tmp_path, extra, why):
     r = subprocess.run([sys.executable, "-m", "cylslam", "run", os.path.join(FIXTURES, "synth_short.jsonl"),
                         "--no-plot", "--out", str(tmp_path / "o")] + extra,

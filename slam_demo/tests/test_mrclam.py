@@ -61,3 +61,35 @@ def test_two_minute_excerpt_known_association():
     assert m["ate_m"] < m["ate_isam_m"] + 0.02
     assert m["association_errors"] == 0 and m["landmarks_matched"] == len(res.lms)
     assert dt < 10
+
+
+def test_several_starts_keep_the_least_cost_solution():
+    """Unknown association on the two-minute excerpt with three starts (online odometry sigmas x1,
+    x0.5, x2): the kept run is the one of least penalised cost, identical to a run of that start
+    alone, and its cost is the graph's error plus the 'no landmark' cost of each unpaired
+    observation plus ln(pairings) per landmark."""
+    from cylslam.noise_model import DEFAULT_PATH, NoiseModel
+    model = NoiseModel.load(DEFAULT_PATH)
+    ds = mrclam.read_mrclam(MR, 2, noise="learned", model=model)
+    rob, k = model.factor_kernel()
+
+    def params(starts):
+        return backend.Params(assoc="unknown", robust=rob, huber_k=k, exclusion=True, reassoc=20, starts=starts)
+    res = backend.Slam(params((1.0, 0.5, 2.0))).run(ds)
+    tried = res.stats["starts"]
+    assert [t["odom_sigma_scale"] for t in tried] == [1.0, 0.5, 2.0]
+    best = min(tried, key=lambda t: t["cost"])
+    assert res.stats["start_chosen"] == best["odom_sigma_scale"]
+    assert len({t["cost"] for t in tried}) > 1          # the starts do end differently
+    alone = backend.Slam(params((best["odom_sigma_scale"],))).run(ds)
+    assert np.allclose(alone.poses, res.poses) and len(alone.lms) == len(res.lms)
+    gate = backend.chi2_2dof(0.99)
+    p1 = params((1.0,))
+    usable = sum(1 for s in ds.steps for o in s.obs if backend.drop_reason(o, p1) is None)
+    want = (res.stats["final_error"] + (usable - len(res.assoc)) * gate / 2
+            + len(res.lms) * math.log(len(res.assoc)))
+    assert res.stats["assoc_cost"] == pytest.approx(want, rel=1e-9)
+    with pytest.raises(ValueError, match="re-association"):
+        backend.Slam(backend.Params(assoc="unknown", starts=(1.0, 0.5))).run(ds)
+    with pytest.raises(ValueError, match="> 0"):
+        backend.Slam(backend.Params(assoc="unknown", reassoc=2, starts=(1.0, 0.0))).run(ds)
