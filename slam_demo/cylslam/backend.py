@@ -647,6 +647,28 @@ class Slam:
                       lm_cov=lm_cov, lm_class=lm_class, lm_ids=lm_ids, assoc=assoc, stats=st,
                       info=info, lm_keys=lm_keys)
 
+    def _solve_pairings(self, base_f, est, pairs):
+        """The graph of `base_f` and one range-bearing factor per (step, observation, covariance,
+        landmark) of `pairs`, solved by Levenberg-Marquardt from `est` (poses, and the landmarks
+        the pairs name): (graph, estimate)."""
+        graph = gtsam.NonlinearFactorGraph()
+        for f in base_f:
+            graph.add(f)
+        for (i, o, c, j) in pairs:
+            graph.add(gtsam.BearingRangeFactor2D(X(i), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
+                                                 self._obs_noise(c)))
+        used = {j for (_, _, _, j) in pairs}
+        v = gtsam.Values()
+        for key in est.keys():
+            sym = gtsam.Symbol(key)
+            if sym.chr() == ord("x"):
+                v.insert(key, est.atPose2(key))
+            elif sym.index() in used:
+                v.insert(key, est.atPoint2(key))
+        lp = gtsam.LevenbergMarquardtParams()
+        lp.setMaxIterations(100)
+        return graph, gtsam.LevenbergMarquardtOptimizer(graph, v, lp).optimize()
+
     def _reassociate(self, frames, base_f, est, graph, assoc, lm_class, merged_into, gate, st, rebuild=False):
         """Batch re-association (`reassoc` passes at most): every usable observation of every frame
         is paired again, against the landmarks at the batch estimate, with the frame's Hungarian
@@ -666,21 +688,8 @@ class Slam:
         p = self.p
         if rebuild:
             cov_of = {id(o): c for (_, u, cs) in frames for o, c in zip(u, cs)}
-            graph = gtsam.NonlinearFactorGraph()
-            for f in base_f:
-                graph.add(f)
-            for (i, o, j) in assoc:
-                graph.add(gtsam.BearingRangeFactor2D(X(i), L(_root(merged_into, j)), gtsam.Rot2(o.bearing_rad),
-                                                     o.range_m, self._obs_noise(cov_of[id(o)])))
-            v = gtsam.Values()
-            used = {_root(merged_into, j) for (_, _, j) in assoc}
-            for key in est.keys():
-                sym = gtsam.Symbol(key)
-                if sym.chr() == ord("x"):
-                    v.insert(key, est.atPose2(key))
-                elif sym.index() in used:
-                    v.insert(key, est.atPoint2(key))
-            est = gtsam.LevenbergMarquardtOptimizer(graph, v).optimize()
+            graph, est = self._solve_pairings(base_f, est, [(i, o, cov_of[id(o)], _root(merged_into, j))
+                                                            for (i, o, j) in assoc])
         lms = sorted({_root(merged_into, j) for (_, _, j) in assoc})
         cur = {(i, id(o)): _root(merged_into, j) for (i, o, j) in assoc}
         cnt = {j: 1 for j in lms}
@@ -748,22 +757,7 @@ class Slam:
             # a 2-cycle (a few pairings flipping back and forth between passes) ends the passes too
             cycle = changed > 0 and now == before
             before, cur = cur, now
-            graph = gtsam.NonlinearFactorGraph()
-            for f in base_f:
-                graph.add(f)
-            for (i, o, c, j) in new:
-                graph.add(gtsam.BearingRangeFactor2D(X(i), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
-                                                     self._obs_noise(c)))
-            v = gtsam.Values()
-            for key in est.keys():
-                sym = gtsam.Symbol(key)
-                if sym.chr() == ord("x"):
-                    v.insert(key, est.atPose2(key))
-                elif sym.index() in cnt:
-                    v.insert(key, est.atPoint2(key))
-            lp = gtsam.LevenbergMarquardtParams()
-            lp.setMaxIterations(100)
-            est = gtsam.LevenbergMarquardtOptimizer(graph, v, lp).optimize()
+            graph, est = self._solve_pairings(base_f, est, new)
             assoc = [(i, o, j) for (i, o, _, j) in new]
             if changed == 0 or cycle:
                 st["reassoc_cycle"] = cycle
