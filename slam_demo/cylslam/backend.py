@@ -207,6 +207,9 @@ def calib_prior(cov):
     return gtsam.PriorFactorVector(CALIB, np.zeros(8), gtsam.noiseModel.Gaussian.Covariance(c))
 
 
+BIG = 1e9      # an assignment cost that stands for "not allowed" (Hungarian cost matrices)
+
+
 def hungarian(cost):
     """Minimum-cost assignment of rows to distinct columns (rows <= cols). Returns col per row.
     SciPy's linear_sum_assignment (the Jonker-Volgenant algorithm)."""
@@ -273,6 +276,20 @@ class Params:
                                    # observation that starts it, taken out of each cov_frame) |
                                    # none (white noise like the rest of cov_frame) | auto (state
                                    # where the observation that starts a landmark has the field)
+
+    def check(self):
+        """The batch re-association's and the starts' constraints: ValueError naming the option
+        (the command line's flags) when they are not met."""
+        if self.reassoc < 0:
+            raise ValueError(f"--reassoc {self.reassoc}: must be >= 0")
+        if self.reassoc and not self.batch:
+            raise ValueError(f"--reassoc {self.reassoc}: batch re-association needs the batch pass (not --no-batch)")
+        if self.reassoc and self.calib_states and self.fixed_cov is None:
+            raise ValueError(f"--reassoc {self.reassoc}: batch re-association cannot run with --calib-states")
+        if not self.starts or any(not (x > 0) for x in self.starts):
+            raise ValueError(f"--starts {self.starts!r}: every odometry sigma scale must be > 0")
+        if tuple(self.starts) != (1.0,) and not self.reassoc:
+            raise ValueError("--starts needs --reassoc (the re-association scores the passes)")
 
 
 @dataclass
@@ -353,10 +370,7 @@ class Slam:
         through depends on the odometry's sigmas; the whole-run likelihood, not the gate, decides
         between the outcomes."""
         p = self.p
-        if not p.starts or any(not (x > 0) for x in p.starts):
-            raise ValueError(f"starts: odometry sigma scales must be > 0, got {p.starts!r}")
-        if (len(p.starts) > 1 or p.starts[0] != 1.0) and not p.reassoc:
-            raise ValueError("several starts need batch re-association (--reassoc), which scores them")
+        p.check()
         t0 = time.perf_counter()
         best = self._run(ds, p.starts[0])
         if len(p.starts) == 1 or best.stats["association"] != "unknown":
@@ -411,8 +425,6 @@ class Slam:
             graph.add(f)
             new_f.add(f)
             new_v.insert(CALIB, np.zeros(8))
-        if p.reassoc and mode == "unknown" and (use_calib or not p.batch):
-            raise ValueError("batch re-association (--reassoc) needs the batch pass and no calibration states")
         rbm = None
         if p.calib_model not in ("exact", "linear"):
             raise ValueError(f"unknown calibration model {p.calib_model!r}")
@@ -611,7 +623,7 @@ class Slam:
                                                            merged_into, gate, st, rebuild=scale != 1.0)
             n_frames_obs = sum(len(u) for _, u, _ in frames)
             st["assoc_cost"] = (graph.error(est) + (n_frames_obs - len(assoc)) * gate / 2
-                                + (len(lm_class) - len(removed)) * math.log(max(len(assoc), 2)))
+                                + len({j for (_, _, j) in assoc}) * math.log(max(len(assoc), 2)))
         st["odom_sigma_scale"] = scale
         t_batch = time.perf_counter() - t0 - t_isam
         poses = _poses(est, n)
@@ -692,7 +704,6 @@ class Slam:
                                                             for (i, o, j) in assoc])
         lms = sorted({_root(merged_into, j) for (_, _, j) in assoc})
         cur = {(i, id(o)): _root(merged_into, j) for (i, o, j) in assoc}
-        cnt = {j: 1 for j in lms}
         st["reassoc_changed"] = []
         st["reassoc_merges"] = 0
         before = None                        # the pairings of the pass before the last
@@ -707,7 +718,7 @@ class Slam:
                 cols = [j for j in lms if any(lm_class[j] == o.cls for o in usable)]
                 if not cols:
                     continue
-                cost = np.full((len(usable), len(cols) + len(usable)), np.inf)
+                cost = np.full((len(usable), len(cols) + len(usable)), BIG)
                 for a, (o, R) in enumerate(zip(usable, covs)):
                     z = np.array([o.range_m, o.bearing_rad])
                     for c, j in enumerate(cols):
@@ -721,8 +732,8 @@ class Slam:
                         if d2 <= gate:
                             cost[a, c] = d2
                     cost[a, len(cols) + a] = gate
-                for a, c in enumerate(hungarian(np.where(np.isfinite(cost), cost, 1e9))):
-                    if c < len(cols) and np.isfinite(cost[a, c]):
+                for a, c in enumerate(hungarian(cost)):
+                    if c < len(cols) and cost[a, c] < BIG:
                         new.append((i, usable[a], covs[a], cols[c]))
             # duplicates: never paired in one frame, and compatible
             together = set()
@@ -731,10 +742,10 @@ class Slam:
                 per_step.setdefault(i, set()).add(j)
             for js in per_step.values():
                 together.update((x, y) for x in js for y in js if x < y)
-            used = sorted({j for (_, _, _, j) in new})
+            lms = sorted({j for (_, _, _, j) in new})
             pairs = []
-            for k, x in enumerate(used):
-                for y in used[k + 1:]:
+            for k, x in enumerate(lms):
+                for y in lms[k + 1:]:
                     if lm_class[x] == lm_class[y] and (x, y) not in together:
                         dv = pos[x] - pos[y]
                         d2 = float(dv @ np.linalg.solve(P[x] + P[y], dv))
@@ -747,10 +758,7 @@ class Slam:
                     into[y] = x
             st["reassoc_merges"] += len(into)
             new = [(i, o, c, into.get(j, j)) for (i, o, c, j) in new]
-            cnt = {}
-            for (_, _, _, j) in new:
-                cnt[j] = cnt.get(j, 0) + 1
-            lms = sorted(cnt)
+            lms = [j for j in lms if j not in into]
             now = {(i, id(o)): j for (i, o, _, j) in new}
             changed = sum(1 for key in cur.keys() | now.keys() if cur.get(key) != now.get(key))
             st["reassoc_changed"].append(changed)
@@ -762,7 +770,7 @@ class Slam:
             if changed == 0 or cycle:
                 st["reassoc_cycle"] = cycle
                 break
-        removed = {j for j in range(len(lm_class)) if j not in cnt}
+        removed = set(range(len(lm_class))) - set(lms)
         merged_into.clear()                  # every pairing names its landmark itself now
         return graph, est, assoc, removed
 
@@ -887,7 +895,6 @@ class Slam:
             pt = isam.calculateEstimatePoint2(L(j))
             lms_init[j] = np.array([pt[0], pt[1]])
         nobs, ncand = len(usable), len(allc)
-        BIG = 1e9
         cost = np.full((nobs, ncand + nobs), BIG)
         d2s = [dict() for _ in range(nobs)]
         gated = {}                          # (observation, landmark) -> (innovation, H, rows of Sig)

@@ -56,16 +56,13 @@ def _scales(text):
 
 
 def _reassoc_conflict(args):
-    """--reassoc with an option it cannot run with: the message, True."""
-    n = getattr(args, "reassoc", 0)
-    if getattr(args, "starts", None) and args.starts != (1.0,) and not n:
-        print("cylslam: error: --starts needs --reassoc (the re-association scores the passes)", file=sys.stderr)
+    """The run's parameters break a constraint of Params.check: the message, True."""
+    try:
+        _params(args).check()
+    except ValueError as e:
+        print(f"cylslam: error: {e}", file=sys.stderr)
         return True
-    why = ("must be >= 0" if n < 0 else "needs the batch pass (not --no-batch)" if n and args.no_batch else
-           "cannot run with --calib-states" if n and getattr(args, "calib_states", False) else None)
-    if why:
-        print(f"cylslam: error: --reassoc {n}: {why}", file=sys.stderr)
-    return why is not None
+    return False
 
 
 def _params(args, **over):
