@@ -56,7 +56,7 @@ def learn(build, tmp, tag, train, classes, learn_args):
         return table, json.load(f)
 
 
-def gate_config(tmp, tag, report, margin, fill, gap, size=None, size_gate=0.0):
+def gate_config(tmp, tag, report, margin, fill, gap, size=None, size_gate=0.0, split=0.0):
     """What cyl-train learn --config-out writes for these gate settings (checked against it in
     make realeval, which uses --config-out itself); size: the landmarks' "diameter,height", m,
     for the expected-size gate (scored with a camera)."""
@@ -69,6 +69,8 @@ def gate_config(tmp, tag, report, margin, fill, gap, size=None, size_gate=0.0):
             lines.append(f"    aspect_range: [{lo / margin:.6g}, {hi * margin:.6g}]")
         if size:
             lines += [f"    size_m: [{size}]", f"    size_gate: {size_gate}"]
+        if split > 0:
+            lines.append(f"    split_waist: {split}")
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")
     return path
@@ -121,6 +123,7 @@ def main():
         "min_fill": [0.3],      # 0.5 loses cones (a triangle fills half its box); 0 keeps lines
         "merge_gap": [3],       # 8 changed nothing on the first 59 candidates
         "size_gate": [2.0],     # the rendered scene's, scored with its camera (1.5-3 tried: the same)
+        "split_waist": [0.0],
     }
     for g in a.gate_grid:
         key, _, vals = g.partition("=")
@@ -145,22 +148,22 @@ def main():
                 tr = [p for p in ball_train if realeval.ball_year(p) != y]
                 learned[y] = learn(a.build, tmp, f"ball{y}", tr, [("ball", 0)], la)
             learned["frc"] = learn(a.build, tmp, "frc", sets["frc"]["train"], [("cone", 0), ("cube", 1)], la)
-            for margin, fill, gap, size_gate in itertools.product(*gate_grid.values()):
+            for margin, fill, gap, size_gate, split in itertools.product(*gate_grid.values()):
                 found = boxes = 0
                 ball_fp = 0.0
                 for y in years:
                     va = [p for p in ball_train if realeval.ball_year(p) == y]
                     t, rep = learned[y]
-                    c = gate_config(tmp, f"ball{y}", rep, margin, fill, gap)
+                    c = gate_config(tmp, f"ball{y}", rep, margin, fill, gap, split=split)
                     r = score(a.build, tmp, f"ball{y}", t, c, va, [("ball", 0)])["classes"]["ball"]
                     found += r["recall_iou50_min12px"] * r["boxes_min12px"]
                     boxes += r["boxes_min12px"]
                     ball_fp = max(ball_fp, r["fp_per_image"])
                 t, rep = learned["frc"]
-                c = gate_config(tmp, "frc", rep, margin, fill, gap)
+                c = gate_config(tmp, "frc", rep, margin, fill, gap, split=split)
                 frc = score(a.build, tmp, "frc", t, c, sets["frc"]["tune"], [("cone", 0), ("cube", 1)])["classes"]
                 t, rep = learned["hard"]
-                c = gate_config(tmp, "hard", rep, margin, fill, gap, realeval.HARD_LANDMARK_SIZE, size_gate)
+                c = gate_config(tmp, "hard", rep, margin, fill, gap, realeval.HARD_LANDMARK_SIZE, size_gate, split)
                 hd = score(a.build, tmp, "hard", t, c, hard_imgs[1:], [("orange", 0), ("green", 1)],
                            hard_cam if size_gate > 0 else None)["classes"]
                 hard_rec = realeval.pooled_recall(hd)
@@ -177,7 +180,7 @@ def main():
                 row = {"fpr": fpr, "smooth": smooth, "weak_fpr": wfpr, "min_weak_ratio": wratio, "gains": gains,
                        "colour_temps": temps, "white_lifts": lifts, "surround": sur, "surround_weight": surw,
                        "aspect_margin": margin, "min_fill": fill, "hard_fp": round(hard_fp, 2),
-                       "merge_gap": gap, "size_gate": size_gate, **{k: round(v, 3) for k, v in rec.items()}, "fp_max": round(fp, 2),
+                       "merge_gap": gap, "size_gate": size_gate, "split_waist": split, **{k: round(v, 3) for k, v in rec.items()}, "fp_max": round(fp, 2),
                        "objective": round(objective, 3), "mean_recall": round(mean_recall, 3)}
                 print(json.dumps(row), flush=True)
                 if best is None or (row["objective"], row["mean_recall"]) > (best["objective"], best["mean_recall"]):

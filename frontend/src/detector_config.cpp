@@ -79,7 +79,7 @@ const std::vector<std::string> kGrouping = {"overlap_min", "scale_tol", "gap_sla
                                             "max_candidates"};
 const std::vector<std::string> kModel = {"name", "bands", "band_heights_m", "shape", "diameter_m", "id"};
 const std::vector<std::string> kClass = {"min_area_px", "max_area_px", "merge_gap_px", "merge_min_density", "size_m",
-                                         "size_gate", "aspect_range", "min_fill"};
+                                         "size_gate", "aspect_range", "min_fill", "split_waist"};
 
 void read_class(const Reader &r, const YAML::Node &n, const std::string &where, DetectorConfig &cfg, unsigned k)
 {
@@ -103,6 +103,7 @@ void read_class(const Reader &r, const YAML::Node &n, const std::string &where, 
         g.aspect_max = v[1];
     }
     if (n["min_fill"]) g.min_fill = r.number(n["min_fill"], where + ".min_fill", 0, 1, false);
+    if (n["split_waist"]) cfg.split.waist_ratio[k] = r.number(n["split_waist"], where + ".split_waist", 0, 1, false);
     if (n["size_gate"]) {
         g.size_gate = r.number(n["size_gate"], where + ".size_gate", 0, 100, false);
         if (g.size_gate > 0 && g.size_gate < 1) r.fail(n["size_gate"], where + ".size_gate: 0 (off) or >= 1");
@@ -327,6 +328,10 @@ std::string detector_config_yaml(const DetectorConfig &cfg, const cyl_colortable
         }
         if (g.min_fill > 0) {
             std::snprintf(b, sizeof b, "    min_fill: %.3g\n", g.min_fill);
+            e += b;
+        }
+        if (cfg.split.waist_ratio[k] > 0) {
+            std::snprintf(b, sizeof b, "    split_waist: %.3g\n", cfg.split.waist_ratio[k]);
             e += b;
         }
         if (cfg.observe.size[k].diameter_m > 0) {

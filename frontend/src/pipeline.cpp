@@ -76,6 +76,9 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
     cyl_status s = cyl_segment(&table_, &img, &config_.segment, &seg_);
     check(s, "segmentation");
     truncated_ = s == CYL_TRUNCATED;
+    s = split_blobs(config_, seg_, split_work_);
+    check(s, "splitting blobs");
+    truncated_ = truncated_ || s == CYL_TRUNCATED;
     // The image estimator reads the frame and the table (and the segmentation's own parameters,
     // recorded in seg_).
     config_.observe.image = &img;
@@ -163,6 +166,16 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
     }
     obs_.resize(k);
     return obs_;
+}
+
+cyl_status split_blobs(const DetectorConfig &cfg, cyl_segmentation &seg, std::vector<uint8_t> &work)
+{
+    bool any = false;
+    for (double r : cfg.split.waist_ratio) any = any || r > 0;
+    if (!any) return CYL_OK;
+    const size_t need = cyl_segment_split_work_size(&seg);
+    if (work.size() < need) work.resize(need);
+    return cyl_segment_split(&seg, &cfg.split, work.data(), work.size(), nullptr);
 }
 
 bool blob_passes(const DetectorConfig &cfg, const cyl_blob &b, uint32_t frame_width, uint32_t frame_height)

@@ -72,6 +72,8 @@ const char *kUsage =
     "                      width/height range widened by --aspect-margin (default 2) each way,\n"
     "                      min_fill (default 0.3) and merge_gap_px (default 3)\n"
     "  --aspect-margin M, --min-fill F, --merge-gap N   (for --config-out)\n"
+    "  --split-waist R     (for --config-out) cut a blob where its rows narrow to below R of its\n"
+    "                      widest rows above and below (two landmarks touching; default 0: off)\n"
     "  --size NAME=D,H     (for --config-out, repeatable) the class's landmark diameter and height,\n"
     "                      m: the config gets size_m and the expected-size gate at the measured range\n"
     "  --size-gate F       that gate's factor for classes given a size (default 2; 0: off)\n"
@@ -475,7 +477,7 @@ int run_gui(Opts &o, cyl_colortable &t, const cyl_train_params &params)
 int learn_main(int argc, char **argv)
 {
     std::string out, base, report, config_out;
-    double aspect_margin = 2.0, min_fill = 0.3, size_gate = 2.0;
+    double aspect_margin = 2.0, min_fill = 0.3, size_gate = 2.0, split_waist = 0.0;
     bool weak_fpr_given = false;
     std::vector<std::pair<std::string, cyl_landmark_size>> sizes;
     long merge_gap = 3;
@@ -497,6 +499,7 @@ int learn_main(int argc, char **argv)
             else if (s == "--config-out") config_out = next();
             else if (s == "--aspect-margin") aspect_margin = parse_num(s, next(), 1, 100, false);
             else if (s == "--min-fill") min_fill = parse_num(s, next(), 0, 1, false);
+            else if (s == "--split-waist") split_waist = parse_num(s, next(), 0, 1, false);
             else if (s == "--size-gate") {
                 size_gate = parse_num(s, next(), 0, 100, false);
                 if (size_gate > 0 && size_gate < 1) throw Usage("--size-gate: 0 (off) or >= 1");
@@ -591,6 +594,7 @@ int learn_main(int argc, char **argv)
             for (const learn::ClassReport &c : r.classes) {
                 cfg.segment.cls[c.index].merge_gap_px = (int32_t)merge_gap;
                 cfg.gate[c.index].min_fill = min_fill;
+                cfg.split.waist_ratio[c.index] = split_waist;
                 if (c.aspect_max > 0) {
                     cfg.gate[c.index].aspect_min = c.aspect_min / aspect_margin;
                     cfg.gate[c.index].aspect_max = c.aspect_max * aspect_margin;

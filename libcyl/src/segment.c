@@ -917,3 +917,144 @@ static cyl_status finish(cyl_segmentation *seg, const cyl_image *img, const cyl_
     }
     return seg->truncated ? CYL_TRUNCATED : CYL_OK;
 }
+
+/* ---- splitting at a waist ---------------------------------------------------- */
+
+cyl_split_params cyl_split_params_default(void)
+{
+    cyl_split_params p;
+    unsigned k;
+    for (k = 0; k < CYL_MAX_CLASSES; k++) p.waist_ratio[k] = 0.0;
+    p.min_part_rows = 4;
+    p.min_part_share = 0.15;
+    return p;
+}
+
+size_t cyl_segment_split_work_size(const cyl_segmentation *seg)
+{
+    uint32_t rows;
+    if (!seg || seg->y_step == 0 || seg->y_last < seg->y_origin) return 0;
+    rows = (seg->y_last - seg->y_origin) / seg->y_step + 1u;
+    return 2u * (size_t)rows * sizeof(uint32_t);
+}
+
+/* Statistics of the run list starting at first (CYL_NONE-terminated) into b (class and the flags
+ * other than the touches kept). */
+static void blob_from_runs(cyl_segmentation *seg, cyl_blob *b, uint32_t first)
+{
+    blob_acc a;
+    uint32_t ri;
+    const uint32_t xs = seg->x_step;
+    memset(&a, 0, sizeof a);
+    b->first_run = first;
+    b->n_runs = 0;
+    b->flags = (uint8_t)(b->flags & ~CYL_BLOB_TOUCH_ANY);
+    b->x0 = 0xFFFFu; b->x1 = 0; b->y0 = seg->runs[first].y;
+    for (ri = first; ri != CYL_NONE; ri = seg->runs[ri].next) {
+        const cyl_run *r = &seg->runs[ri];
+        const uint32_t xe = r->x + (uint32_t)(r->width - 1u) * xs;
+        if (r->x < b->x0) b->x0 = r->x;
+        if (xe > b->x1) b->x1 = (uint16_t)xe;
+        b->y1 = r->y;
+        b->n_runs++;
+        acc_add_run(&a, r, xs);
+    }
+    finish_blob(seg, b, &a);
+}
+
+/* The row (image y) to cut blob b at, or 0 for none. ext, suf: one counter a sampled row. */
+static uint32_t find_waist(const cyl_segmentation *seg, const cyl_blob *b, double ratio,
+                           const cyl_split_params *p, uint32_t *ext, uint32_t *suf)
+{
+    const uint32_t ys = seg->y_step, xs = seg->x_step;
+    const uint32_t rows = (uint32_t)(b->y1 - b->y0) / ys + 1u;
+    uint32_t need = (uint32_t)ceil(p->min_part_share * (double)rows), ri, j, best_j = 0, pre = 0;
+    double best = ratio;
+    if (need < p->min_part_rows) need = p->min_part_rows;
+    if (need < 1u) need = 1u;
+    if (rows < 2u * need) return 0;
+    /* each row's extent: first sample of its first run to last sample of its last run (0 where
+     * the blob has no run in the row: the gap between merged pieces, never a cut) */
+    for (j = 0; j < rows; j++) ext[j] = 0;
+    {
+        uint32_t lo = 0, row = CYL_NONE;
+        for (ri = b->first_run; ri != CYL_NONE; ri = seg->runs[ri].next) {
+            const cyl_run *r = &seg->runs[ri];
+            const uint32_t jr = (uint32_t)(r->y - b->y0) / ys, xe = r->x + (uint32_t)(r->width - 1u) * xs;
+            if (jr != row) { row = jr; lo = r->x; }
+            ext[jr] = xe - lo + 1u;   /* runs of a row come in x order */
+        }
+    }
+    suf[rows - 1u] = ext[rows - 1u];
+    for (j = rows - 1u; j-- > 0;) suf[j] = ext[j] > suf[j + 1u] ? ext[j] : suf[j + 1u];
+    for (j = 0; j + need <= rows; j++) {
+        if (j >= need) {
+            const uint32_t below = j + 1u < rows ? suf[j + 1u] : 0u;   /* widest row below j */
+            const uint32_t m = pre < below ? pre : below;
+            if (m > 0 && ext[j] > 0 && (double)ext[j] < best * (double)m) {
+                best = (double)ext[j] / (double)m;
+                best_j = j;
+            }
+        }
+        if (ext[j] > pre) pre = ext[j];
+    }
+    return best_j ? b->y0 + best_j * ys : 0u;
+}
+
+cyl_status cyl_segment_split(cyl_segmentation *seg, const cyl_split_params *p, void *work, size_t work_size,
+                             uint32_t *n_split)
+{
+    uint32_t i, k, cuts = 0, full = 0, rows;
+    uint32_t *ext, *suf;
+    int any = 0;
+    if (n_split) *n_split = 0;
+    if (!seg || !p || !seg->runs || !seg->blobs) return CYL_ERR_ARG;
+    if (!(p->min_part_share >= 0.0 && p->min_part_share <= 0.5)) return CYL_ERR_ARG;
+    for (k = 0; k < CYL_MAX_CLASSES; k++) {
+        if (!(p->waist_ratio[k] >= 0.0 && p->waist_ratio[k] <= 1.0)) return CYL_ERR_ARG;
+        any |= p->waist_ratio[k] > 0.0;
+    }
+    if (!any || seg->n_blobs == 0) return CYL_OK;
+    if (!work || work_size < cyl_segment_split_work_size(seg)) return CYL_ERR_SIZE;
+    rows = (uint32_t)(cyl_segment_split_work_size(seg) / (2u * sizeof(uint32_t)));
+    ext = (uint32_t *)work;
+    suf = ext + rows;
+    /* blobs appended by a cut are examined in turn: a part may have a waist of its own */
+    for (i = 0; i < seg->n_blobs; i++) {
+        cyl_blob *b = &seg->blobs[i];
+        const double ratio = p->waist_ratio[b->cls];
+        uint32_t cut, ri, prev = CYL_NONE;
+        if (ratio <= 0.0) continue;
+        cut = find_waist(seg, b, ratio, p, ext, suf);
+        if (!cut) continue;
+        if (seg->n_blobs >= seg->max_blobs) { full = 1; continue; }
+        for (ri = b->first_run; ri != CYL_NONE && seg->runs[ri].y < cut; ri = seg->runs[ri].next) prev = ri;
+        if (prev == CYL_NONE || ri == CYL_NONE) continue;   /* cannot happen: both parts have rows */
+        seg->runs[prev].next = CYL_NONE;
+        {
+            cyl_blob *nb = &seg->blobs[seg->n_blobs++];
+            *nb = *b;
+            nb->flags |= CYL_BLOB_SPLIT;
+            blob_from_runs(seg, nb, ri);
+        }
+        b->flags |= CYL_BLOB_SPLIT;
+        blob_from_runs(seg, b, b->first_run);
+        cuts++;
+        i--;   /* the upper part again */
+    }
+    if (cuts) {
+        sort_blobs(seg->blobs, seg->n_blobs);
+        for (k = 0; k < CYL_MAX_CLASSES; k++) { seg->class_first[k] = 0; seg->class_count[k] = 0; }
+        for (k = 0; k < seg->n_blobs; k++) {
+            uint32_t ri;
+            for (ri = seg->blobs[k].first_run; ri != CYL_NONE; ri = seg->runs[ri].next) seg->runs[ri].blob = k;
+            if (seg->class_count[seg->blobs[k].cls]++ == 0) seg->class_first[seg->blobs[k].cls] = k;
+        }
+    }
+    if (n_split) *n_split = cuts;
+    if (full) {
+        seg->truncated |= CYL_SEG_BLOBS_FULL;
+        return CYL_TRUNCATED;
+    }
+    return CYL_OK;
+}

@@ -162,7 +162,9 @@ def process(ds, args, label, outdir):
         scales = FIXED_GRID if (args.fixed_cov in ("grid", "frame-grid") and has_truth) else (1.0,)
         best = None
         why = []
+        grid_ate = {}   # every scale's ATE (None: failed or mapped nothing), for a choice made elsewhere
         for sc in scales:
+            grid_ate[f"{sc:g}"] = None
             try:
                 rf = Slam(_params(args, **{key_cov: mean * sc}, covariances=(len(scales) == 1)),
                           progress=Progress(f"{label} fixed x{sc:g}", args.progress)).run(ds)
@@ -175,6 +177,7 @@ def process(ds, args, label, outdir):
                 why.append(f"x{sc:g}: mapped no landmark")
                 continue
             key = mf.get("ate_m", 0.0)
+            grid_ate[f"{sc:g}"] = mf.get("ate_m")
             if best is None or key < best[0]:
                 best = (key, sc, rf, mf)
         what = ("the mean per-observation frame covariance (calibration and bias states kept)"
@@ -182,6 +185,8 @@ def process(ds, args, label, outdir):
         summary["fixed_cov_tuning"] = ("grid over " + ",".join(f"{s:g}" for s in scales) + " x " + what +
                                        ", best ATE among the runs that map landmarks"
                                        if len(scales) > 1 else what)
+        if has_truth and len(scales) > 1:
+            summary["fixed_cov_grid_ate_m"] = grid_ate
         if best is None:
             summary["fixed_cov_failed"] = (f"none of the {len(scales)} fixed covariances gave a map: "
                                            + "; ".join(why))

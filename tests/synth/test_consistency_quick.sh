@@ -4,7 +4,8 @@
 # frames, the imaging sweep at reduced sizes, the pixel-noise-only NEES). Asserts what holds today
 # and would catch a regression: no association error, the pixel-only NEES within 1.6-2.6 (2
 # expected, no floor), the image estimator's ratio to the measured variance within 0.5-1.5 over
-# the sweep, every seed's SLAM run producing both ANEES figures with their bounds. The full
+# the sweep, every seed's SLAM run producing both ANEES figures with their bounds and the fixed
+# covariance's ATE at every scale of its grid (the best of them the one reported). The full
 # figures (20 seeds) are make consistency's. GoogleTest-style lines.
 #   test_consistency_quick.sh BUILD_DIR
 set -u
@@ -28,7 +29,13 @@ for row in rows:
     for k in ("anees_landmarks", "anees_poses"):
         if not (isinstance(row[k], float) and row[k] > 0 and row[k + "_bounds95"]):
             bad.append(f"seed {row['seed']}: no {k}")
-for k in ("seeds_landmark_anees_in_bounds", "seeds_pose_anees_in_bounds", "ate_better_than_fixed_frac"):
+    g = row.get("fixed_cov_grid_ate_m") or {}
+    if sorted(g) != ["0.25", "0.5", "1", "2", "4"] or not all(v is None or 0 < v < 1 for v in g.values()):
+        bad.append(f"seed {row['seed']}: fixed-covariance grid ATEs {g}")
+    elif row["ate_fixed_cov_m"] != min(v for v in g.values() if v is not None):
+        bad.append(f"seed {row['seed']}: best fixed ATE {row['ate_fixed_cov_m']} is not the grid's least")
+for k in ("seeds_landmark_anees_in_bounds", "seeds_pose_anees_in_bounds", "ate_better_than_fixed_frac",
+          "ate_better_than_tuned_fixed_frac"):
     if not 0 <= r[k] <= 1: bad.append(f"{k} {r[k]}")
 print("; ".join(bad))
 PY

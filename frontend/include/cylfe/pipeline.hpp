@@ -36,6 +36,7 @@ struct DetectorConfig {
     cyl_segment_params segment = cyl_segment_params_default();
     cyl_observe_params observe = cyl_observe_params_default_frame();  // image and table set per frame
     ClassGate gate[CYL_MAX_CLASSES];
+    cyl_split_params split = cyl_split_params_default();  // blobs cut at a waist (two landmarks touching)
     std::vector<uint8_t> mask;   // width*height bytes, 0 = not a landmark (the robot's own body); empty: none
     uint32_t mask_width = 0, mask_height = 0;
     uint32_t max_runs = 65536;   // run capacity per frame
@@ -53,6 +54,10 @@ struct DetectorConfig {
 
 // The classes some landmark model uses, as a bit mask (bit k: class k).
 uint32_t model_classes(const DetectorConfig &cfg);
+
+// Cut the blobs of seg at their waists by cfg.split (cyl_segment_split; nothing when no class
+// has a waist ratio); work grows as needed. Returns the status (CYL_TRUNCATED: blob capacity).
+cyl_status split_blobs(const DetectorConfig &cfg, cyl_segmentation &seg, std::vector<uint8_t> &work);
 
 // The gates that need no camera (area, aspect, fill, mask) on one blob of a frame.
 bool blob_passes(const DetectorConfig &cfg, const cyl_blob &b, uint32_t frame_width, uint32_t frame_height);
@@ -101,7 +106,7 @@ private:
     cyl_colortable table_;
     cyl_camera camera_;
     DetectorConfig config_;
-    std::vector<uint8_t> seg_mem_, obs_work_;
+    std::vector<uint8_t> seg_mem_, obs_work_, split_work_;
     cyl_segmentation seg_{};
     std::vector<cyl_observation> obs_;
     std::vector<std::array<uint16_t, 4>> boxes_;

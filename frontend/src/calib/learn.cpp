@@ -500,6 +500,7 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
     double mpx_total = 0;
     std::vector<uint8_t> mem;
     cyl_segmentation seg{};
+    std::vector<uint8_t> split_work;
     uint32_t cap_w = 0, cap_h = 0;
     size_t done = 0;
     // one row per labelled box; false blobs too, with matched_iou "false_blob" and their area in
@@ -522,6 +523,7 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
         check(cyl_segment(&t, &img, &o.detector.segment, &seg), path + ": segmentation");
         auto t1 = std::chrono::steady_clock::now();
         us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+        check(split_blobs(o.detector, seg, split_work), path + ": splitting blobs");
         const double frame_px = (double)img.width * img.height;
         mpx_total += frame_px / 1e6;
         if (det) {

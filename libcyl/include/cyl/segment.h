@@ -57,6 +57,7 @@ typedef struct cyl_run {
 #define CYL_BLOB_TOUCH_BOTTOM 0x08u  /* ... in the last sampled row */
 #define CYL_BLOB_TOUCH_ANY    0x0Fu
 #define CYL_BLOB_MERGED       0x10u  /* made of more than one 4-connected component */
+#define CYL_BLOB_SPLIT        0x20u  /* one part of a blob cut at a waist (cyl_segment_split) */
 
 /* One blob: 4-connected runs of one class, possibly merged with nearby ones. */
 typedef struct cyl_blob {
@@ -175,6 +176,39 @@ cyl_status cyl_segment_band(const cyl_colortable *t, const cyl_image *img, const
 cyl_status cyl_segment_join(const cyl_colortable *t, const cyl_image *img, const cyl_segment_params *p,
                             const cyl_run *const *band_runs, const uint32_t *band_n_runs, unsigned n_bands,
                             cyl_segmentation *seg);
+
+/* ---- splitting blobs at a waist ---------------------------------------------
+ * Two landmarks of one class that touch in the image, one above the other (a far cone whose
+ * base meets the tip of a nearer one), form one blob. Its rows' extents narrow between the
+ * two: cyl_segment_split() cuts a blob at the row where the extent (first to last sample of
+ * the row) is smallest against the widest row above it and the widest row below it, when that
+ * share is below the class's waist_ratio and both parts keep enough rows. The parts are split
+ * again if they have a waist of their own. A single cylinder, box, ball or cone (extents that
+ * grow, stay or shrink steadily) has no waist. */
+typedef struct cyl_split_params {
+    double waist_ratio[CYL_MAX_CLASSES]; /* split a blob of class k at a row whose extent is
+                                            below this share of the widest rows both above and
+                                            below it, 0..1 (0: never; default 0) */
+    uint16_t min_part_rows;              /* each part keeps at least this many sampled rows
+                                            (default 4) */
+    double min_part_share;               /* ... and this share of the blob's rows, 0..0.5
+                                            (default 0.15) */
+} cyl_split_params;
+
+/* Defaults described above (every waist_ratio 0: nothing is split). */
+cyl_split_params cyl_split_params_default(void);
+
+/* Bytes of workspace cyl_segment_split() needs after a segmentation of this frame (two
+ * counters a sampled row of seg's grid). */
+size_t cyl_segment_split_work_size(const cyl_segmentation *seg);
+
+/* Split seg's blobs at their waists (above), in place: each part becomes a blob with its own
+ * statistics and the flag CYL_BLOB_SPLIT, the blobs are sorted again (seg->blobs' order), and
+ * runs, class_first and class_count follow. *n_split (may be NULL): cuts made. CYL_TRUNCATED
+ * when seg->max_blobs stopped a cut (seg->truncated gains CYL_SEG_BLOBS_FULL); CYL_ERR_ARG for
+ * bad parameters, CYL_ERR_SIZE for a workspace smaller than cyl_segment_split_work_size(). */
+cyl_status cyl_segment_split(cyl_segmentation *seg, const cyl_split_params *p, void *work, size_t work_size,
+                             uint32_t *n_split);
 
 #ifdef __cplusplus
 }
