@@ -170,9 +170,6 @@ const std::vector<cyl_observation> &Detector::process(const cyl_image &img)
 
 cyl_status split_blobs(const DetectorConfig &cfg, cyl_segmentation &seg, std::vector<uint8_t> &work)
 {
-    bool any = false;
-    for (double r : cfg.split.waist_ratio) any = any || r > 0;
-    if (!any) return CYL_OK;
     const size_t need = cyl_segment_split_work_size(&seg);
     if (work.size() < need) work.resize(need);
     return cyl_segment_split(&seg, &cfg.split, work.data(), work.size(), nullptr);

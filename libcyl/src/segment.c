@@ -652,6 +652,20 @@ static void sort_blobs(cyl_blob *v, uint32_t n)
     }
 }
 
+/* Each run's blob index from the (sorted) blobs' run lists, CYL_NONE for runs of no blob (dropped),
+ * and class_first / class_count. */
+static void label_runs(cyl_segmentation *seg)
+{
+    uint32_t i, k;
+    for (i = 0; i < seg->n_runs; i++) seg->runs[i].blob = CYL_NONE;
+    for (k = 0; k < CYL_MAX_CLASSES; k++) { seg->class_first[k] = 0; seg->class_count[k] = 0; }
+    for (k = 0; k < seg->n_blobs; k++) {
+        uint32_t ri;
+        for (ri = seg->blobs[k].first_run; ri != CYL_NONE; ri = seg->runs[ri].next) seg->runs[ri].blob = k;
+        if (seg->class_count[seg->blobs[k].cls]++ == 0) seg->class_first[seg->blobs[k].cls] = k;
+    }
+}
+
 static cyl_status check_params(const cyl_segment_params *p)
 {
     unsigned i;
@@ -845,11 +859,7 @@ static cyl_status finish(cyl_segmentation *seg, const cyl_image *img, const cyl_
     seg->frame_width = img->width;
     seg->frame_height = img->height;
     seg->min_run_px = p->min_run_px;
-    for (k = 0; k < CYL_MAX_CLASSES; k++) {
-        seg->class_first[k] = 0;
-        seg->class_count[k] = 0;
-        seg->merge_gap_px[k] = p->cls[k].merge_gap_px;
-    }
+    for (k = 0; k < CYL_MAX_CLASSES; k++) seg->merge_gap_px[k] = p->cls[k].merge_gap_px;
 
     /* 2. labels: flatten, then number the roots in raster order. A root's
      *    label is parked in its `next` field until every run is labelled. */
@@ -908,13 +918,8 @@ static cyl_status finish(cyl_segmentation *seg, const cyl_image *img, const cyl_
     seg->n_blobs = k;
     sort_blobs(seg->blobs, k);
 
-    /* 5. final labels: runs of dropped blobs get CYL_NONE */
-    for (i = 0; i < n_runs; i++) runs[i].blob = CYL_NONE;
-    for (k = 0; k < seg->n_blobs; k++) {
-        uint32_t ri;
-        for (ri = seg->blobs[k].first_run; ri != CYL_NONE; ri = runs[ri].next) runs[ri].blob = k;
-        if (seg->class_count[seg->blobs[k].cls]++ == 0) seg->class_first[seg->blobs[k].cls] = k;
-    }
+    /* 5. final labels */
+    label_runs(seg);
     return seg->truncated ? CYL_TRUNCATED : CYL_OK;
 }
 
@@ -930,12 +935,16 @@ cyl_split_params cyl_split_params_default(void)
     return p;
 }
 
+/* Sampled rows of seg's grid (0 before a segmentation). */
+static uint32_t grid_rows(const cyl_segmentation *seg)
+{
+    if (seg->y_step == 0 || seg->y_last < seg->y_origin) return 0;
+    return (seg->y_last - seg->y_origin) / seg->y_step + 1u;
+}
+
 size_t cyl_segment_split_work_size(const cyl_segmentation *seg)
 {
-    uint32_t rows;
-    if (!seg || seg->y_step == 0 || seg->y_last < seg->y_origin) return 0;
-    rows = (seg->y_last - seg->y_origin) / seg->y_step + 1u;
-    return 2u * (size_t)rows * sizeof(uint32_t);
+    return seg ? 2u * (size_t)grid_rows(seg) * sizeof(uint32_t) : 0;
 }
 
 /* Statistics of the run list starting at first (CYL_NONE-terminated) into b (class and the flags
@@ -1004,7 +1013,7 @@ static uint32_t find_waist(const cyl_segmentation *seg, const cyl_blob *b, doubl
 cyl_status cyl_segment_split(cyl_segmentation *seg, const cyl_split_params *p, void *work, size_t work_size,
                              uint32_t *n_split)
 {
-    uint32_t i, k, cuts = 0, full = 0, rows;
+    uint32_t i = 0, k, cuts = 0, full = 0;
     uint32_t *ext, *suf;
     int any = 0;
     if (n_split) *n_split = 0;
@@ -1016,20 +1025,21 @@ cyl_status cyl_segment_split(cyl_segmentation *seg, const cyl_split_params *p, v
     }
     if (!any || seg->n_blobs == 0) return CYL_OK;
     if (!work || work_size < cyl_segment_split_work_size(seg)) return CYL_ERR_SIZE;
-    rows = (uint32_t)(cyl_segment_split_work_size(seg) / (2u * sizeof(uint32_t)));
     ext = (uint32_t *)work;
-    suf = ext + rows;
-    /* blobs appended by a cut are examined in turn: a part may have a waist of its own */
-    for (i = 0; i < seg->n_blobs; i++) {
+    suf = ext + grid_rows(seg);
+    /* a blob that was cut is examined again (its upper part), and the lower parts appended at the
+     * end in turn: a part may have a waist of its own */
+    while (i < seg->n_blobs) {
         cyl_blob *b = &seg->blobs[i];
         const double ratio = p->waist_ratio[b->cls];
-        uint32_t cut, ri, prev = CYL_NONE;
-        if (ratio <= 0.0) continue;
-        cut = find_waist(seg, b, ratio, p, ext, suf);
-        if (!cut) continue;
-        if (seg->n_blobs >= seg->max_blobs) { full = 1; continue; }
-        for (ri = b->first_run; ri != CYL_NONE && seg->runs[ri].y < cut; ri = seg->runs[ri].next) prev = ri;
-        if (prev == CYL_NONE || ri == CYL_NONE) continue;   /* cannot happen: both parts have rows */
+        uint32_t cut = ratio > 0.0 ? find_waist(seg, b, ratio, p, ext, suf) : 0u, ri, prev = CYL_NONE;
+        if (!cut || seg->n_blobs >= seg->max_blobs) {
+            full |= cut != 0u;
+            i++;
+            continue;
+        }
+        /* both parts have rows (find_waist), so the cut lies strictly inside the run list */
+        for (ri = b->first_run; seg->runs[ri].y < cut; ri = seg->runs[ri].next) prev = ri;
         seg->runs[prev].next = CYL_NONE;
         {
             cyl_blob *nb = &seg->blobs[seg->n_blobs++];
@@ -1040,16 +1050,10 @@ cyl_status cyl_segment_split(cyl_segmentation *seg, const cyl_split_params *p, v
         b->flags |= CYL_BLOB_SPLIT;
         blob_from_runs(seg, b, b->first_run);
         cuts++;
-        i--;   /* the upper part again */
     }
     if (cuts) {
         sort_blobs(seg->blobs, seg->n_blobs);
-        for (k = 0; k < CYL_MAX_CLASSES; k++) { seg->class_first[k] = 0; seg->class_count[k] = 0; }
-        for (k = 0; k < seg->n_blobs; k++) {
-            uint32_t ri;
-            for (ri = seg->blobs[k].first_run; ri != CYL_NONE; ri = seg->runs[ri].next) seg->runs[ri].blob = k;
-            if (seg->class_count[seg->blobs[k].cls]++ == 0) seg->class_first[seg->blobs[k].cls] = k;
-        }
+        label_runs(seg);
     }
     if (n_split) *n_split = cuts;
     if (full) {

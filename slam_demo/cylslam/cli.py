@@ -176,8 +176,7 @@ def process(ds, args, label, outdir):
             if has_truth and mf.get("landmark_rmse_m") is None:
                 why.append(f"x{sc:g}: mapped no landmark")
                 continue
-            key = mf.get("ate_m", 0.0)
-            grid_ate[f"{sc:g}"] = mf.get("ate_m")
+            key = grid_ate[f"{sc:g}"] = mf.get("ate_m", 0.0)
             if best is None or key < best[0]:
                 best = (key, sc, rf, mf)
         what = ("the mean per-observation frame covariance (calibration and bias states kept)"

@@ -55,8 +55,8 @@ struct DetectorConfig {
 // The classes some landmark model uses, as a bit mask (bit k: class k).
 uint32_t model_classes(const DetectorConfig &cfg);
 
-// Cut the blobs of seg at their waists by cfg.split (cyl_segment_split; nothing when no class
-// has a waist ratio); work grows as needed. Returns the status (CYL_TRUNCATED: blob capacity).
+// Cut the blobs of seg at their waists by cfg.split (cyl_segment_split, which does nothing when no
+// class has a waist ratio); work grows as needed. Returns the status (CYL_TRUNCATED: blob capacity).
 cyl_status split_blobs(const DetectorConfig &cfg, cyl_segmentation &seg, std::vector<uint8_t> &work);
 
 // The gates that need no camera (area, aspect, fill, mask) on one blob of a frame.
