@@ -61,7 +61,7 @@ tools: $(BUILD)/cyl
 # ---- frontend unit tests (GoogleTest) ------------------------------------------------------
 FE_TEST_SRCS := $(sort $(wildcard tests/frontend/test_*.cpp))
 FE_TEST_BINS := $(FE_TEST_SRCS:tests/frontend/%.cpp=$(BUILD)/tests/fe_%)
-$(BUILD)/tests/fe_%: tests/frontend/%.cpp $(FE_SYNTH_OBJS) $(FRONTEND_A) lib
+$(BUILD)/tests/fe_%: tests/frontend/%.cpp $(wildcard tests/frontend/*.hpp) $(FE_SYNTH_OBJS) $(FRONTEND_A) lib
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS_ALL) $(CV_FLAGS) $< -o $@ $(FE_SYNTH_OBJS) $(FRONTEND_A) $(LIBCYL_A) $(CV_LIBS) -lgtest -lgtest_main -pthread -lm
 TEST_EXTRA += $(FE_TEST_BINS)

@@ -73,7 +73,8 @@ const char *kUsage =
     "                      min_fill (default 0.3) and merge_gap_px (default 3)\n"
     "  --aspect-margin M, --min-fill F, --merge-gap N   (for --config-out)\n"
     "  --split-waist R     (for --config-out) cut a blob where its rows narrow to below R of its\n"
-    "                      widest rows above and below (two landmarks touching; default 0: off)\n"
+    "                      widest rows above and below (two landmarks touching, one above the\n"
+    "                      other; default 0.5; 0: off)\n"
     "  --size NAME=D,H     (for --config-out, repeatable) the class's landmark diameter and height,\n"
     "                      m: the config gets size_m and the expected-size gate at the measured range\n"
     "  --size-gate F       that gate's factor for classes given a size (default 2; 0: off)\n"
@@ -477,7 +478,7 @@ int run_gui(Opts &o, cyl_colortable &t, const cyl_train_params &params)
 int learn_main(int argc, char **argv)
 {
     std::string out, base, report, config_out;
-    double aspect_margin = 2.0, min_fill = 0.3, size_gate = 2.0, split_waist = 0.0;
+    double aspect_margin = 2.0, min_fill = 0.3, size_gate = 2.0, split_waist = 0.5;
     bool weak_fpr_given = false;
     std::vector<std::pair<std::string, cyl_landmark_size>> sizes;
     long merge_gap = 3;

@@ -978,7 +978,7 @@ static uint32_t find_waist(const cyl_segmentation *seg, const cyl_blob *b, doubl
     const uint32_t ys = seg->y_step, xs = seg->x_step;
     const uint32_t rows = (uint32_t)(b->y1 - b->y0) / ys + 1u;
     uint32_t need = (uint32_t)ceil(p->min_part_share * (double)rows), ri, j, best_j = 0, pre = 0;
-    double best = ratio;
+    uint32_t best_ext = 0, best_m = 0;
     if (need < p->min_part_rows) need = p->min_part_rows;
     if (need < 1u) need = 1u;
     if (rows < 2u * need) return 0;
@@ -1000,8 +1000,12 @@ static uint32_t find_waist(const cyl_segmentation *seg, const cyl_blob *b, doubl
         if (j >= need) {
             const uint32_t below = j + 1u < rows ? suf[j + 1u] : 0u;   /* widest row below j */
             const uint32_t m = pre < below ? pre : below;
-            if (m > 0 && ext[j] > 0 && (double)ext[j] < best * (double)m) {
-                best = (double)ext[j] / (double)m;
+            /* below the ratio, and the least share so far (compared exactly: on a tie the
+             * upper row stays) */
+            if (m > 0 && ext[j] > 0 && (double)ext[j] < ratio * (double)m &&
+                (best_j == 0 || (uint64_t)ext[j] * best_m < (uint64_t)best_ext * m)) {
+                best_ext = ext[j];
+                best_m = m;
                 best_j = j;
             }
         }

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "config_file.hpp"
 #include "cylfe/error.hpp"
 #include "cylfe/overlay.hpp"
 #include "cylfe/pipeline.hpp"
@@ -27,16 +28,7 @@ cyl_colortable table3()
     return t;
 }
 
-std::string write_tmp(const std::string &text)
-{
-    char name[] = "/tmp/cyl_lmcfg_XXXXXX";
-    int fd = mkstemp(name);
-    EXPECT_GE(fd, 0);
-    FILE *f = fdopen(fd, "w");
-    std::fputs(text.c_str(), f);
-    std::fclose(f);
-    return name;
-}
+using cfgtest::write_tmp;
 
 const char *kGood = "landmarks:\n"
                     "  plane_height_m: 0.15\n"
@@ -57,18 +49,8 @@ const char *kGood = "landmarks:\n"
 // the error message of loading text, or "" if it loads
 std::string error_of(const std::string &text)
 {
-    const std::string p = write_tmp(text);
-    cyl_colortable t = table3();
     DetectorConfig c;
-    std::string msg;
-    try {
-        load_detector_config(p, t, c);
-    } catch (const Error &e) {
-        msg = e.what();
-        if (msg.compare(0, p.size(), p) == 0) msg = "FILE" + msg.substr(p.size());
-    }
-    std::remove(p.c_str());
-    return msg;
+    return cfgtest::load_error(text, table3(), c);
 }
 
 int seg_blob_at(const cyl_segmentation &seg, int x, int y)

@@ -1020,6 +1020,342 @@ static void test_records_its_parameters(void **state)
     fx_close(&f);
 }
 
+/* ---- splitting at a waist --------------------------------------------------- */
+
+/* A cone-like shape: rows ytop..ytop+rows-1, each one run centred on cx whose width goes
+ * linearly from w_top to w_bottom. */
+static void draw_taper(canvas *c, int32_t cx, int32_t ytop, int32_t rows, int32_t w_top, int32_t w_bottom,
+                       uint8_t Y, uint8_t U, uint8_t V)
+{
+    int32_t j;
+    for (j = 0; j < rows; j++) {
+        const int32_t w = rows > 1 ? w_top + (int32_t)lround((double)(w_bottom - w_top) * j / (rows - 1)) : w_top;
+        canvas_rect(c, cx - w / 2, ytop + j, w, 1, Y, U, V);
+    }
+}
+
+/* The segmentation's invariants after a split: every run of a blob's list is labelled with the
+ * blob, runs in (y, x) order within a list, the statistics that the runs give (area, box, run
+ * count, centroid), the blobs' order, class_first and class_count. */
+static void check_split_consistent(const cyl_segmentation *seg)
+{
+    uint32_t k, ri, labelled = 0, cnt[CYL_MAX_CLASSES] = { 0 };
+    for (k = 0; k < seg->n_blobs; k++) {
+        const cyl_blob *b = &seg->blobs[k];
+        uint32_t area = 0, n = 0, x0 = 0xFFFF, x1 = 0, y0 = 0xFFFF, y1 = 0, py = 0, px = 0;
+        double sx = 0, sy = 0;
+        for (ri = b->first_run; ri != CYL_NONE; ri = seg->runs[ri].next) {
+            const cyl_run *r = &seg->runs[ri];
+            const uint32_t xe = r->x + (uint32_t)(r->width - 1u) * seg->x_step;
+            uint32_t q;
+            assert_int_equal(r->blob, k);
+            assert_int_equal(r->cls, b->cls);
+            if (n) assert_true(r->y > py || (r->y == py && r->x > px));
+            py = r->y; px = r->x;
+            for (q = 0; q < r->width; q++) { sx += r->x + (double)q * seg->x_step; sy += r->y; }
+            area += r->width; n++;
+            if (r->x < x0) x0 = r->x;
+            if (xe > x1) x1 = xe;
+            if (r->y < y0) y0 = r->y;
+            if (r->y > y1) y1 = r->y;
+        }
+        labelled += n;
+        assert_int_equal(b->area, area); assert_int_equal(b->n_runs, n);
+        assert_int_equal(b->x0, x0); assert_int_equal(b->x1, x1);
+        assert_int_equal(b->y0, y0); assert_int_equal(b->y1, y1);
+        assert_true(fabs(b->cx_px - sx / area) < 1e-9 && fabs(b->cy_px - sy / area) < 1e-9);
+        if (k > 0) {
+            const cyl_blob *a = &seg->blobs[k - 1];
+            assert_true(a->cls < b->cls || (a->cls == b->cls && (a->area > b->area ||
+                        (a->area == b->area && (a->y0 < b->y0 || (a->y0 == b->y0 && a->x0 <= b->x0))))));
+        }
+        if (cnt[b->cls]++ == 0) assert_int_equal(seg->class_first[b->cls], k);
+    }
+    for (k = 0; k < CYL_MAX_CLASSES; k++) assert_int_equal(seg->class_count[k], cnt[k]);
+    for (ri = 0, k = 0; ri < seg->n_runs; ri++) k += seg->runs[ri].blob != CYL_NONE;
+    assert_int_equal(k, labelled);
+}
+
+static cyl_status fx_split(fixture *f, const cyl_split_params *sp, uint32_t *n_split)
+{
+    const size_t ws = cyl_segment_split_work_size(&f->seg);
+    void *work = malloc(ws ? ws : 1);
+    cyl_status st = cyl_segment_split(&f->seg, sp, work, ws, n_split);
+    free(work);
+    return st;
+}
+
+/* Two orange cones, the far one's base on the near one's tip, and a green one alone: the pair is
+ * cut at the tip's row, and each part's statistics are those of its cone segmented alone. */
+static void test_split_stacked_cones(void **state)
+{
+    fixture f, g;
+    cyl_split_params sp = cyl_split_params_default();
+    cyl_blob alone[2];
+    uint32_t n_split = 99, k;
+    (void)state;
+    fx_open(&f, 120, 100, 4000, 64);
+    fx_open(&g, 120, 100, 4000, 64);
+    /* far cone: rows 10..29, 4 -> 20 px wide; near cone: rows 30..79, 6 -> 40 px wide */
+    draw_taper(&f.c, 40, 10, 20, 4, 20, ORANGE);
+    draw_taper(&f.c, 40, 30, 50, 6, 40, ORANGE);
+    draw_taper(&f.c, 95, 20, 40, 4, 24, GREEN);
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 2);
+    assert_int_equal(f.seg.blobs[0].y0, 10); assert_int_equal(f.seg.blobs[0].y1, 79);
+    /* each alone */
+    draw_taper(&g.c, 40, 10, 20, 4, 20, ORANGE);
+    assert_int_equal(fx_run(&g, CYL_FMT_YUV444P, 0), CYL_OK);
+    alone[1] = g.seg.blobs[0];
+    canvas_fill(&g.c, GREY);
+    draw_taper(&g.c, 40, 30, 50, 6, 40, ORANGE);
+    assert_int_equal(fx_run(&g, CYL_FMT_YUV444P, 0), CYL_OK);
+    alone[0] = g.seg.blobs[0];
+    /* waist ratio 0 (the default): nothing happens, no workspace needed */
+    assert_int_equal(cyl_segment_split(&f.seg, &sp, NULL, 0, &n_split), CYL_OK);
+    assert_int_equal(n_split, 0);
+    assert_int_equal(f.seg.n_blobs, 2);
+    /* green only: the orange pair stays whole */
+    sp.waist_ratio[1] = 0.9;
+    assert_int_equal(fx_split(&f, &sp, &n_split), CYL_OK);
+    assert_int_equal(n_split, 0);
+    /* orange: the tip row (30) is 6 px against 20 above and 40 below, a share of 0.3 */
+    sp.waist_ratio[0] = 0.25;
+    assert_int_equal(fx_split(&f, &sp, &n_split), CYL_OK);
+    assert_int_equal(n_split, 0);
+    sp.waist_ratio[0] = 0.35;
+    assert_int_equal(fx_split(&f, &sp, &n_split), CYL_OK);
+    assert_int_equal(n_split, 1);
+    assert_int_equal(f.seg.n_blobs, 3);
+    check_split_consistent(&f.seg);
+    for (k = 0; k < 2; k++) {
+        const cyl_blob *b = &f.seg.blobs[k], *a = &alone[k];
+        assert_int_equal(b->cls, 0);
+        assert_int_equal(b->flags, CYL_BLOB_SPLIT);
+        assert_int_equal(b->area, a->area); assert_int_equal(b->n_runs, a->n_runs);
+        assert_int_equal(b->x0, a->x0); assert_int_equal(b->x1, a->x1);
+        assert_int_equal(b->y0, a->y0); assert_int_equal(b->y1, a->y1);
+        assert_true(fabs(b->cx_px - a->cx_px) < 1e-12 && fabs(b->cy_px - a->cy_px) < 1e-12);
+        assert_true(fabs(b->mxx_px2 - a->mxx_px2) < 1e-9 && fabs(b->myy_px2 - a->myy_px2) < 1e-9);
+        assert_true(fabs(b->mxy_px2 - a->mxy_px2) < 1e-9);
+        assert_true(fabs(b->elongation - a->elongation) < 1e-9);
+    }
+    assert_int_equal(f.seg.blobs[2].cls, 1);
+    assert_int_equal(f.seg.blobs[2].flags, 0);
+    assert_int_equal(f.seg.class_first[1], 2);
+    /* split again: the parts have no waist of their own */
+    assert_int_equal(fx_split(&f, &sp, &n_split), CYL_OK);
+    assert_int_equal(n_split, 0);
+    fx_close(&f);
+    fx_close(&g);
+}
+
+/* Single shapes have no waist, even at a ratio of 1: a cylinder (rectangle), a cone, one upside
+ * down, a ball, a box seen from a corner (a hexagon-like taper up then down). */
+static void test_split_single_shapes(void **state)
+{
+    fixture f;
+    cyl_split_params sp = cyl_split_params_default();
+    uint32_t n_split = 99;
+    unsigned k;
+    (void)state;
+    for (k = 0; k < CYL_MAX_CLASSES; k++) sp.waist_ratio[k] = 1.0;
+    sp.min_part_rows = 1;
+    sp.min_part_share = 0.0;
+    fx_open(&f, 240, 100, 8000, 64);
+    canvas_rect(&f.c, 5, 10, 20, 60, ORANGE);
+    draw_taper(&f.c, 50, 10, 60, 4, 40, ORANGE);
+    draw_taper(&f.c, 100, 10, 60, 40, 4, ORANGE);
+    canvas_ellipse(&f.c, 150.3, 40.6, 18.2, 25.7, ORANGE);
+    draw_taper(&f.c, 205, 10, 30, 10, 40, ORANGE);
+    draw_taper(&f.c, 205, 40, 40, 40, 12, ORANGE);
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 5);
+    assert_int_equal(fx_split(&f, &sp, &n_split), CYL_OK);
+    assert_int_equal(n_split, 0);
+    assert_int_equal(f.seg.n_blobs, 5);
+    fx_close(&f);
+}
+
+/* Two pieces merged across a gap of empty rows: the gap rows have no extent and are never a cut,
+ * but a real waist inside a merged blob is. */
+static void test_split_merged_gap(void **state)
+{
+    fixture f;
+    cyl_split_params sp = cyl_split_params_default();
+    uint32_t n_split = 99;
+    (void)state;
+    fx_open(&f, 80, 100, 4000, 64);
+    f.p.cls[0].merge_gap_px = 3;
+    f.p.cls[0].merge_min_density = 0.0;
+    canvas_rect(&f.c, 20, 10, 20, 30, ORANGE);   /* rows 10..39 */
+    canvas_rect(&f.c, 20, 42, 20, 30, ORANGE);   /* rows 42..71: two empty rows between */
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 1);
+    assert_true(f.seg.blobs[0].flags & CYL_BLOB_MERGED);
+    sp.waist_ratio[0] = 1.0;
+    assert_int_equal(fx_split(&f, &sp, &n_split), CYL_OK);
+    assert_int_equal(n_split, 0);
+    /* a 4 px neck in the lower piece (rows 55..56) is a waist: cut at row 55 */
+    canvas_rect(&f.c, 20, 55, 20, 2, GREY);
+    canvas_rect(&f.c, 28, 55, 4, 2, ORANGE);
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 1);
+    sp.waist_ratio[0] = 0.5;
+    assert_int_equal(fx_split(&f, &sp, &n_split), CYL_OK);
+    assert_int_equal(n_split, 1);
+    check_split_consistent(&f.seg);
+    assert_int_equal(f.seg.blobs[0].y0, 10); assert_int_equal(f.seg.blobs[0].y1, 54);
+    assert_int_equal(f.seg.blobs[1].y0, 55); assert_int_equal(f.seg.blobs[1].y1, 71);
+    /* the parts keep the parent's component count and merged flag */
+    assert_int_equal(f.seg.blobs[0].flags, CYL_BLOB_MERGED | CYL_BLOB_SPLIT);
+    assert_int_equal(f.seg.blobs[1].flags, CYL_BLOB_MERGED | CYL_BLOB_SPLIT);
+    fx_close(&f);
+}
+
+/* Brute-force reference: the parts a width profile (one run a sampled row, rows a..b) splits into,
+ * found by trying every row: the least share ext[j] / min(widest above, widest below), below the
+ * ratio, the upper row on a tie, each part at least `need` rows; then each part again. Writes the
+ * parts' first rows to out (in any order); returns their count. */
+static unsigned ref_split(const uint32_t *w, unsigned a, unsigned b, double ratio, const cyl_split_params *sp,
+                          unsigned *out)
+{
+    const unsigned rows = b - a + 1u;
+    unsigned need = (unsigned)ceil(sp->min_part_share * rows), j, best = 0, i;
+    uint32_t be = 0, bm = 0;
+    if (need < sp->min_part_rows) need = sp->min_part_rows;
+    if (need < 1u) need = 1u;
+    if (rows >= 2u * need) {
+        for (j = need; j + need <= rows; j++) {
+            uint32_t above = 0, below = 0, m;
+            for (i = 0; i < j; i++) if (w[a + i] > above) above = w[a + i];
+            for (i = j + 1u; i < rows; i++) if (w[a + i] > below) below = w[a + i];
+            m = above < below ? above : below;
+            if (m == 0 || (double)w[a + j] >= ratio * m) continue;
+            if (best == 0 || (uint64_t)w[a + j] * bm < (uint64_t)be * m) { best = j; be = w[a + j]; bm = m; }
+        }
+    }
+    if (!best) { out[0] = a; return 1; }
+    i = ref_split(w, a, a + best - 1u, ratio, sp, out);
+    return i + ref_split(w, a + best, b, ratio, sp, out + i);
+}
+
+static int cmp_u(const void *x, const void *y)
+{
+    const unsigned a = *(const unsigned *)x, b = *(const unsigned *)y;
+    return (a > b) - (a < b);
+}
+
+/* Random stacks of runs (random widths, or a random walk of widths), sampled every row and every
+ * second row: the parts cyl_segment_split() makes are those of the brute-force reference. */
+static void test_split_bruteforce_random(void **state)
+{
+    enum { W = 240, H = 120, SHAPES = 4, MAXR = 110 };
+    fixture f;
+    test_rng rng;
+    unsigned trial, total_cuts = 0;
+    (void)state;
+    test_rng_seed(&rng, 20261205u);
+    fx_open(&f, W, H, 20000, 256);
+    for (trial = 0; trial < 300; trial++) {
+        uint32_t widths[SHAPES][H], n_split, expect_cuts = 0;
+        unsigned ytop[SHAPES], nrows[SHAPES], s, ys = (trial & 1u) ? 2u : 1u;
+        unsigned exp_y0[SHAPES * MAXR], got_y0[256], shape_parts[SHAPES], n_exp = 0, n_got = 0, k;
+        cyl_split_params sp = cyl_split_params_default();
+        sp.waist_ratio[0] = 0.2 + 0.7 * test_rng_uniform(&rng);
+        sp.min_part_rows = (uint16_t)test_rng_int(&rng, 1, 5);
+        sp.min_part_share = 0.3 * test_rng_uniform(&rng);
+        canvas_fill(&f.c, GREY);
+        f.p.y_step = (uint16_t)ys;
+        for (s = 0; s < SHAPES; s++) {
+            const int walk = (int)test_rng_int(&rng, 0, 1);
+            uint32_t wcur = (uint32_t)test_rng_int(&rng, 4, 50);
+            unsigned j;
+            ytop[s] = (unsigned)test_rng_int(&rng, 0, 20) * 2u;
+            nrows[s] = (unsigned)test_rng_int(&rng, 2, (H - 1 - (int)ytop[s]) / 2) * 2u;
+            for (j = 0; j < nrows[s]; j++) {
+                if (walk) {
+                    wcur = (uint32_t)((int)wcur + (int)test_rng_int(&rng, -6, 6));
+                    if (wcur < 4) wcur = 4;
+                    if (wcur > 56) wcur = 56;
+                } else {
+                    wcur = (uint32_t)test_rng_int(&rng, 4, 56);
+                }
+                widths[s][j] = wcur;
+                canvas_rect(&f.c, 30 + 60 * (int32_t)s - (int32_t)wcur / 2, (int32_t)(ytop[s] + j), (int32_t)wcur, 1,
+                            ORANGE);
+            }
+        }
+        assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+        assert_int_equal(f.seg.n_blobs, SHAPES);
+        /* reference on the sampled rows (even rows when ys = 2: ytop is even) */
+        for (s = 0; s < SHAPES; s++) {
+            uint32_t sw[H];
+            unsigned m = 0, j, parts[H], np;
+            for (j = 0; j < nrows[s]; j += ys) sw[m++] = widths[s][j];
+            np = ref_split(sw, 0, m - 1u, sp.waist_ratio[0], &sp, parts);
+            expect_cuts += np - 1u;
+            shape_parts[s] = np;
+            for (j = 0; j < np; j++) exp_y0[n_exp++] = ytop[s] + parts[j] * ys + 1000u * s;
+        }
+        assert_int_equal(fx_split(&f, &sp, &n_split), CYL_OK);
+        assert_int_equal(n_split, expect_cuts);
+        total_cuts += n_split;
+        check_split_consistent(&f.seg);
+        for (k = 0; k < f.seg.n_blobs; k++) {
+            const cyl_blob *b = &f.seg.blobs[k];
+            const unsigned s_of = (unsigned)(b->x0 + b->x1) / 2u / 60u;   /* shape s lies around 30 + 60 s */
+            assert_int_equal(!!(b->flags & CYL_BLOB_SPLIT), shape_parts[s_of] > 1u);
+            got_y0[n_got++] = b->y0 + 1000u * s_of;
+        }
+        assert_int_equal(n_got, n_exp);
+        qsort(exp_y0, n_exp, sizeof exp_y0[0], cmp_u);
+        qsort(got_y0, n_got, sizeof got_y0[0], cmp_u);
+        for (k = 0; k < n_got; k++) assert_int_equal(got_y0[k], exp_y0[k]);
+    }
+    /* the trials exercised cuts, recursive ones included */
+    assert_true(total_cuts > 300);
+    fx_close(&f);
+}
+
+/* Full blob table: the cut is not made, the segmentation says so; bad parameters; small workspace. */
+static void test_split_capacity_and_arguments(void **state)
+{
+    fixture f;
+    cyl_split_params sp = cyl_split_params_default();
+    uint32_t n_split = 99;
+    uint8_t small[8];
+    (void)state;
+    fx_open(&f, 80, 100, 4000, 1);
+    draw_taper(&f.c, 40, 10, 20, 4, 20, ORANGE);
+    draw_taper(&f.c, 40, 30, 50, 6, 40, ORANGE);
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    sp.waist_ratio[0] = 0.5;
+    assert_int_equal(fx_split(&f, &sp, &n_split), CYL_TRUNCATED);
+    assert_int_equal(n_split, 0);
+    assert_int_equal(f.seg.n_blobs, 1);
+    assert_true(f.seg.truncated & CYL_SEG_BLOBS_FULL);
+    assert_int_equal(f.seg.blobs[0].flags, 0);
+    check_split_consistent(&f.seg);
+    /* the workspace: two counters a sampled row (100 rows) */
+    assert_int_equal(cyl_segment_split_work_size(&f.seg), 2u * 100u * sizeof(uint32_t));
+    assert_int_equal(cyl_segment_split_work_size(NULL), 0);
+    assert_int_equal(cyl_segment_split(&f.seg, &sp, small, sizeof small, &n_split), CYL_ERR_SIZE);
+    assert_int_equal(cyl_segment_split(&f.seg, &sp, NULL, 0, &n_split), CYL_ERR_SIZE);
+    assert_int_equal(cyl_segment_split(NULL, &sp, small, sizeof small, &n_split), CYL_ERR_ARG);
+    assert_int_equal(cyl_segment_split(&f.seg, NULL, small, sizeof small, &n_split), CYL_ERR_ARG);
+    sp.waist_ratio[3] = 1.5;
+    assert_int_equal(cyl_segment_split(&f.seg, &sp, small, sizeof small, &n_split), CYL_ERR_ARG);
+    sp.waist_ratio[3] = -0.1;
+    assert_int_equal(cyl_segment_split(&f.seg, &sp, small, sizeof small, &n_split), CYL_ERR_ARG);
+    sp.waist_ratio[3] = NAN;
+    assert_int_equal(cyl_segment_split(&f.seg, &sp, small, sizeof small, &n_split), CYL_ERR_ARG);
+    sp.waist_ratio[3] = 0.0;
+    sp.min_part_share = 0.6;
+    assert_int_equal(cyl_segment_split(&f.seg, &sp, small, sizeof small, &n_split), CYL_ERR_ARG);
+    fx_close(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1043,6 +1379,11 @@ int main(void)
         cmocka_unit_test(test_vector_path_identical),
         cmocka_unit_test(test_vector_path_name),
         cmocka_unit_test(test_bands_join_identical),
+        cmocka_unit_test(test_split_stacked_cones),
+        cmocka_unit_test(test_split_single_shapes),
+        cmocka_unit_test(test_split_merged_gap),
+        cmocka_unit_test(test_split_bruteforce_random),
+        cmocka_unit_test(test_split_capacity_and_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
