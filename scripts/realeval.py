@@ -15,8 +15,9 @@ One recipe for every set (cyl-train learn and cyl-score with their defaults, no 
     detect's observations against the true landmarks.
 Prints each set's training report and scores, then one JSON line with the figures.
 
-Usage: scripts/realeval.py [--shared DIR] [--build DIR] [--out DIR] [--subset DIR]
+Usage: scripts/realeval.py [--shared DIR] [--build DIR] [--out DIR] [--subset DIR] [--train-option 'OPT V']
   --shared DIR  the folder holding data/real (default ../shared, or $CYL_SHARED)
+  --train-option 'OPT V'  an option for every cyl-train learn, e.g. '--weak-alone-area 1000' (repeatable)
   --subset DIR  run on a small committed subset instead (its own train/test lists): the CI form
 Exit codes: 0 ok, 1 data missing or a tool failed, 2 bad command line.
 """
@@ -157,7 +158,7 @@ def bearing_errors(obslog):
     return errs
 
 
-def hard_synth(build, out, frames, seed=3):
+def hard_synth(build, out, frames, seed=3, extra=()):
     d = os.path.join(out, "hard")
     os.makedirs(d, exist_ok=True)
     raw = os.path.join(d, "drive.cylraw")
@@ -171,7 +172,7 @@ def hard_synth(build, out, frames, seed=3):
     # range), and the scene's camera lets cyl-score score the detector's observations
     table, config = os.path.join(out, "hard.cylt"), os.path.join(out, "hard-detector.yaml")
     sc = learn_and_score(build, out, "hard", imgs[:1], imgs[1:], classes,
-                         [a for c, _ in classes for a in ("--size", f"{c}={HARD_LANDMARK_SIZE}")], cam)["classes"]
+                         [a for c, _ in classes for a in ("--size", f"{c}={HARD_LANDMARK_SIZE}")] + list(extra), cam)["classes"]
     # the same without the camera: the blobs the camera-free gates keep, as on the real sets
     nc = score(build, table, config, classes, os.path.join(out, "hard-test.list"))[1]["classes"]
     log = os.path.join(d, "obs.jsonl")
@@ -203,6 +204,9 @@ def main():
     ap.add_argument("--build", default="build")
     ap.add_argument("--out", default=None, help="keep tables, reports and per-box CSVs here")
     ap.add_argument("--subset", default=None)
+    ap.add_argument("--train-option", action="append", default=[], metavar="'OPT VALUE'",
+                    help="pass an option to every cyl-train learn (repeatable; e.g. '--split-axes both'): "
+                         "how an option that is not a default was measured")
     ap.add_argument("--hard-frames", type=int, default=None,
                     help="frames of the hard rendered scene (default 150; 40 with --subset)")
     a = ap.parse_args()
@@ -221,12 +225,13 @@ def main():
         tmp = tempfile.TemporaryDirectory()
         out = tmp.name
     os.makedirs(out, exist_ok=True)
-    ball = learn_and_score(a.build, out, "ball", sets["ball"]["train"], sets["ball"]["test"], [("ball", 0)])
-    frc = learn_and_score(a.build, out, "frc", sets["frc"]["train"], sets["frc"]["test"], [("cone", 0), ("cube", 1)])
-    hard = hard_synth(a.build, out, a.hard_frames or (40 if a.subset else 150))
+    extra = [w for opt in a.train_option for w in opt.split()]
+    ball = learn_and_score(a.build, out, "ball", sets["ball"]["train"], sets["ball"]["test"], [("ball", 0)], extra)
+    frc = learn_and_score(a.build, out, "frc", sets["frc"]["train"], sets["frc"]["test"], [("cone", 0), ("cube", 1)], extra)
+    hard = hard_synth(a.build, out, a.hard_frames or (40 if a.subset else 150), extra=extra)
     b, co, cu = ball["classes"]["ball"], frc["classes"]["cone"], frc["classes"]["cube"]
     res = {
-        "data": "subset" if a.subset else "full",
+        "data": "subset" if a.subset else "full", "train_options": extra,
         "ball_recall_iou50": b["recall_iou50"], "ball_recall_iou50_min12px": b["recall_iou50_min12px"],
         "ball_recall_centroid": b["recall_centroid"], "ball_recall_centroid_min12px": b["recall_centroid_min12px"],
         "cone_recall_iou50": co["recall_iou50"], "cone_recall_centroid": co["recall_centroid"],

@@ -73,13 +73,14 @@ struct Reader {
     }
 };
 
-const std::vector<std::string> kTop = {"roi", "mask", "min_run_px", "classes", "landmarks"};
+const std::vector<std::string> kTop = {"roi", "mask", "min_run_px", "split_axes", "classes", "landmarks"};
 const std::vector<std::string> kLandmarks = {"plane_height_m", "grouping", "models"};
 const std::vector<std::string> kGrouping = {"overlap_min", "scale_tol", "gap_slack_px", "depression_max_deg",
                                             "max_candidates"};
 const std::vector<std::string> kModel = {"name", "bands", "band_heights_m", "shape", "diameter_m", "id"};
 const std::vector<std::string> kClass = {"min_area_px", "max_area_px", "merge_gap_px", "merge_min_density", "size_m",
-                                         "size_gate", "aspect_range", "min_fill", "split_waist"};
+                                         "size_gate", "aspect_range", "min_fill", "split_waist",
+                                         "weak_alone_min_area_px"};
 
 void read_class(const Reader &r, const YAML::Node &n, const std::string &where, DetectorConfig &cfg, unsigned k)
 {
@@ -103,6 +104,8 @@ void read_class(const Reader &r, const YAML::Node &n, const std::string &where, 
         g.aspect_max = v[1];
     }
     if (n["min_fill"]) g.min_fill = r.number(n["min_fill"], where + ".min_fill", 0, 1, false);
+    if (n["weak_alone_min_area_px"])
+        cp.weak_alone_min_area = (uint32_t)r.number(n["weak_alone_min_area_px"], where + ".weak_alone_min_area_px", 0, 1e9, true);
     if (n["split_waist"]) cfg.split.waist_ratio[k] = r.number(n["split_waist"], where + ".split_waist", 0, 1, false);
     if (n["size_gate"]) {
         g.size_gate = r.number(n["size_gate"], where + ".size_gate", 0, 100, false);
@@ -268,6 +271,13 @@ void load_detector_config(const std::string &path, const cyl_colortable &table, 
         if (v[2] == 0 || v[3] == 0) r.fail(root["roi"], "roi: width and height must be > 0");
     }
     if (root["min_run_px"]) cfg.segment.min_run_px = (uint16_t)r.number(root["min_run_px"], "min_run_px", 1, 1000, true);
+    if (root["split_axes"]) {
+        const YAML::Node a = root["split_axes"];
+        const std::string v = a.IsScalar() ? a.Scalar() : "";
+        const unsigned axes = split_axes_from_name(v);
+        if (!axes) r.fail(a, "split_axes: '" + v + "' is not rows, columns or both");
+        cfg.split.axes = axes;
+    }
     if (root["mask"]) {
         const YAML::Node m = root["mask"];
         if (!m.IsScalar() || m.Scalar().empty()) r.fail(m, "mask: expected a file name");
@@ -309,6 +319,7 @@ std::string detector_config_yaml(const DetectorConfig &cfg, const cyl_colortable
         s += b;
     }
     if (cfg.segment.min_run_px != d.min_run_px) s += "min_run_px: " + std::to_string(cfg.segment.min_run_px) + "\n";
+    if (cfg.split.axes != cyl_split_params_default().axes) s += std::string("split_axes: ") + split_axes_name(cfg.split.axes) + "\n";
     std::string cls;
     for (unsigned k = 0; k < CYL_MAX_CLASSES; k++) {
         if (!table.name[k][0] || table.weak_of[k] != CYL_CLASS_NONE) continue;
@@ -330,6 +341,7 @@ std::string detector_config_yaml(const DetectorConfig &cfg, const cyl_colortable
             std::snprintf(b, sizeof b, "    min_fill: %.3g\n", g.min_fill);
             e += b;
         }
+        if (c.weak_alone_min_area) e += "    weak_alone_min_area_px: " + std::to_string(c.weak_alone_min_area) + "\n";
         if (cfg.split.waist_ratio[k] > 0) {
             std::snprintf(b, sizeof b, "    split_waist: %.3g\n", cfg.split.waist_ratio[k]);
             e += b;

@@ -175,6 +175,19 @@ cyl_status split_blobs(const DetectorConfig &cfg, cyl_segmentation &seg, std::ve
     return cyl_segment_split(&seg, &cfg.split, work.data(), work.size(), nullptr);
 }
 
+unsigned split_axes_from_name(const std::string &name)
+{
+    if (name == "rows") return CYL_SPLIT_ROWS;
+    if (name == "columns") return CYL_SPLIT_COLUMNS;
+    if (name == "both") return CYL_SPLIT_ROWS | CYL_SPLIT_COLUMNS;
+    return 0;
+}
+
+const char *split_axes_name(unsigned axes)
+{
+    return axes == CYL_SPLIT_ROWS ? "rows" : axes == CYL_SPLIT_COLUMNS ? "columns" : "both";
+}
+
 bool blob_passes(const DetectorConfig &cfg, const cyl_blob &b, uint32_t frame_width, uint32_t frame_height)
 {
     const ClassGate &g = cfg.gate[b.cls];

@@ -75,6 +75,11 @@ const char *kUsage =
     "  --split-waist R     (for --config-out) cut a blob where its rows narrow to below R of its\n"
     "                      widest rows above and below (two landmarks touching, one above the\n"
     "                      other; default 0.5; 0: off)\n"
+    "  --split-axes A      (for --config-out) cut between rows (default), columns (side by side)\n"
+    "                      or both\n"
+    "  --weak-alone-area N (for --config-out) a blob of weak pixels alone (no pixel of the class\n"
+    "                      itself: a landmark in shade) counts when it has at least N px\n"
+    "                      (default 0: never)\n"
     "  --size NAME=D,H     (for --config-out, repeatable) the class's landmark diameter and height,\n"
     "                      m: the config gets size_m and the expected-size gate at the measured range\n"
     "  --size-gate F       that gate's factor for classes given a size (default 2; 0: off)\n"
@@ -479,6 +484,8 @@ int learn_main(int argc, char **argv)
 {
     std::string out, base, report, config_out;
     double aspect_margin = 2.0, min_fill = 0.3, size_gate = 2.0, split_waist = 0.5;
+    unsigned split_axes = cyl_split_params_default().axes;
+    long weak_alone = 0;
     bool weak_fpr_given = false;
     std::vector<std::pair<std::string, cyl_landmark_size>> sizes;
     long merge_gap = 3;
@@ -501,6 +508,12 @@ int learn_main(int argc, char **argv)
             else if (s == "--aspect-margin") aspect_margin = parse_num(s, next(), 1, 100, false);
             else if (s == "--min-fill") min_fill = parse_num(s, next(), 0, 1, false);
             else if (s == "--split-waist") split_waist = parse_num(s, next(), 0, 1, false);
+            else if (s == "--weak-alone-area") weak_alone = (long)parse_num(s, next(), 0, 1e9, true);
+            else if (s == "--split-axes") {
+                const std::string v = next();
+                split_axes = split_axes_from_name(v);
+                if (!split_axes) throw Usage("--split-axes: '" + v + "' is not rows, columns or both");
+            }
             else if (s == "--size-gate") {
                 size_gate = parse_num(s, next(), 0, 100, false);
                 if (size_gate > 0 && size_gate < 1) throw Usage("--size-gate: 0 (off) or >= 1");
@@ -596,6 +609,8 @@ int learn_main(int argc, char **argv)
                 cfg.segment.cls[c.index].merge_gap_px = (int32_t)merge_gap;
                 cfg.gate[c.index].min_fill = min_fill;
                 cfg.split.waist_ratio[c.index] = split_waist;
+                cfg.split.axes = split_axes;
+                cfg.segment.cls[c.index].weak_alone_min_area = (uint32_t)weak_alone;
                 if (c.aspect_max > 0) {
                     cfg.gate[c.index].aspect_min = c.aspect_min / aspect_margin;
                     cfg.gate[c.index].aspect_max = c.aspect_max * aspect_margin;

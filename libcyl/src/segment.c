@@ -54,6 +54,7 @@ cyl_segment_params cyl_segment_params_default(void)
         p.cls[i].min_area = 9;
         p.cls[i].merge_gap_px = 3;
         p.cls[i].merge_min_density = 0.5;
+        p.cls[i].weak_alone_min_area = 0;
     }
     return p;
 }
@@ -910,7 +911,10 @@ static cyl_status finish(cyl_segmentation *seg, const cyl_image *img, const cyl_
     k = 0;
     for (i = 0; i < nb; i++) {
         if (!acc[i].alive || acc[i].n < (int64_t)p->cls[seg->blobs[i].cls].min_area) continue;
-        if (weak && !acc[i].strong) continue;   /* weak evidence alone is no blob */
+        if (weak && !acc[i].strong) {   /* weak evidence alone is no blob, unless it is large */
+            const uint32_t alone = p->cls[seg->blobs[i].cls].weak_alone_min_area;
+            if (alone == 0 || acc[i].n < (int64_t)alone) continue;
+        }
         if (k != i) seg->blobs[k] = seg->blobs[i];
         finish_blob(seg, &seg->blobs[k], &acc[i]);
         k++;
@@ -930,21 +934,33 @@ cyl_split_params cyl_split_params_default(void)
     cyl_split_params p;
     unsigned k;
     for (k = 0; k < CYL_MAX_CLASSES; k++) p.waist_ratio[k] = 0.0;
-    p.min_part_rows = 4;
+    p.axes = CYL_SPLIT_ROWS;
+    p.min_part_lines = 4;
     p.min_part_share = 0.15;
     return p;
 }
 
-/* Sampled rows of seg's grid (0 before a segmentation). */
+/* Sampled rows and columns of seg's grid (0 before a segmentation). */
 static uint32_t grid_rows(const cyl_segmentation *seg)
 {
     if (seg->y_step == 0 || seg->y_last < seg->y_origin) return 0;
     return (seg->y_last - seg->y_origin) / seg->y_step + 1u;
 }
 
+static uint32_t grid_cols(const cyl_segmentation *seg)
+{
+    if (seg->x_step == 0 || seg->x_last < seg->x_origin) return 0;
+    return (seg->x_last - seg->x_origin) / seg->x_step + 1u;
+}
+
 size_t cyl_segment_split_work_size(const cyl_segmentation *seg)
 {
-    return seg ? 2u * (size_t)grid_rows(seg) * sizeof(uint32_t) : 0;
+    uint32_t rows, cols;
+    if (!seg) return 0;
+    rows = grid_rows(seg);
+    cols = grid_cols(seg);
+    /* two profiles of the longer axis, and the runs a column cut crosses (one a row at most) */
+    return (2u * (size_t)(rows > cols ? rows : cols) + rows) * sizeof(uint32_t);
 }
 
 /* Statistics of the run list starting at first (CYL_NONE-terminated) into b (class and the flags
@@ -971,37 +987,24 @@ static void blob_from_runs(cyl_segmentation *seg, cyl_blob *b, uint32_t first)
     finish_blob(seg, b, &a);
 }
 
-/* The row (image y) to cut blob b at, or 0 for none. ext, suf: one counter a sampled row. */
-static uint32_t find_waist(const cyl_segmentation *seg, const cyl_blob *b, double ratio,
-                           const cyl_split_params *p, uint32_t *ext, uint32_t *suf)
+/* The waist of a profile ext[0..n-1] (0: no sample there, never a cut): the index j whose ext[j]
+ * is the least share of m = min(widest before j, widest after j), below ratio, with at least
+ * `need` entries on each side (ties: the first). 0 for none; *share_num / *share_den the share.
+ * suf: n counters of workspace. */
+static uint32_t profile_waist(const uint32_t *ext, uint32_t *suf, uint32_t n, uint32_t need, double ratio,
+                              uint32_t *share_num, uint32_t *share_den)
 {
-    const uint32_t ys = seg->y_step, xs = seg->x_step;
-    const uint32_t rows = (uint32_t)(b->y1 - b->y0) / ys + 1u;
-    uint32_t need = (uint32_t)ceil(p->min_part_share * (double)rows), ri, j, best_j = 0, pre = 0;
-    uint32_t best_ext = 0, best_m = 0;
-    if (need < p->min_part_rows) need = p->min_part_rows;
+    uint32_t j, best_j = 0, pre = 0, best_ext = 0, best_m = 0;
     if (need < 1u) need = 1u;
-    if (rows < 2u * need) return 0;
-    /* each row's extent: first sample of its first run to last sample of its last run (0 where
-     * the blob has no run in the row: the gap between merged pieces, never a cut) */
-    for (j = 0; j < rows; j++) ext[j] = 0;
-    {
-        uint32_t lo = 0, row = CYL_NONE;
-        for (ri = b->first_run; ri != CYL_NONE; ri = seg->runs[ri].next) {
-            const cyl_run *r = &seg->runs[ri];
-            const uint32_t jr = (uint32_t)(r->y - b->y0) / ys, xe = r->x + (uint32_t)(r->width - 1u) * xs;
-            if (jr != row) { row = jr; lo = r->x; }
-            ext[jr] = xe - lo + 1u;   /* runs of a row come in x order */
-        }
-    }
-    suf[rows - 1u] = ext[rows - 1u];
-    for (j = rows - 1u; j-- > 0;) suf[j] = ext[j] > suf[j + 1u] ? ext[j] : suf[j + 1u];
-    for (j = 0; j + need <= rows; j++) {
+    if (n < 2u * need) return 0;
+    suf[n - 1u] = ext[n - 1u];
+    for (j = n - 1u; j-- > 0;) suf[j] = ext[j] > suf[j + 1u] ? ext[j] : suf[j + 1u];
+    for (j = 0; j + need <= n; j++) {
         if (j >= need) {
-            const uint32_t below = j + 1u < rows ? suf[j + 1u] : 0u;   /* widest row below j */
-            const uint32_t m = pre < below ? pre : below;
+            const uint32_t after = j + 1u < n ? suf[j + 1u] : 0u;
+            const uint32_t m = pre < after ? pre : after;
             /* below the ratio, and the least share so far (compared exactly: on a tie the
-             * upper row stays) */
+             * first stays) */
             if (m > 0 && ext[j] > 0 && (double)ext[j] < ratio * (double)m &&
                 (best_j == 0 || (uint64_t)ext[j] * best_m < (uint64_t)best_ext * m)) {
                 best_ext = ext[j];
@@ -1011,45 +1014,196 @@ static uint32_t find_waist(const cyl_segmentation *seg, const cyl_blob *b, doubl
         }
         if (ext[j] > pre) pre = ext[j];
     }
-    return best_j ? b->y0 + best_j * ys : 0u;
+    *share_num = best_ext;
+    *share_den = best_m;
+    return best_j;
+}
+
+/* Entries each part keeps along an axis of n entries. */
+static uint32_t part_need(const cyl_split_params *p, uint32_t n)
+{
+    uint32_t need = (uint32_t)ceil(p->min_part_share * (double)n);
+    return need < p->min_part_lines ? p->min_part_lines : need;
+}
+
+/* Blob b's row profile: each sampled row's extent, first sample of its first run to last sample
+ * of its last run, in samples (0 where the blob has no run in the row: the gap between merged
+ * pieces). Returns the rows. */
+static uint32_t row_profile(const cyl_segmentation *seg, const cyl_blob *b, uint32_t *ext)
+{
+    const uint32_t ys = seg->y_step, xs = seg->x_step;
+    const uint32_t rows = (uint32_t)(b->y1 - b->y0) / ys + 1u;
+    uint32_t j, ri, lo = 0, row = CYL_NONE;
+    for (j = 0; j < rows; j++) ext[j] = 0;
+    for (ri = b->first_run; ri != CYL_NONE; ri = seg->runs[ri].next) {
+        const cyl_run *r = &seg->runs[ri];
+        const uint32_t jr = (uint32_t)(r->y - b->y0) / ys;
+        if (jr != row) { row = jr; lo = r->x; }
+        ext[jr] = (r->x - lo) / xs + r->width;   /* runs of a row come in x order */
+    }
+    return rows;
+}
+
+/* Blob b's column profile: each sampled column's extent, its first to its last sampled row with
+ * a sample, in rows (0 where the column has none). top: workspace of the columns. */
+static uint32_t col_profile(const cyl_segmentation *seg, const cyl_blob *b, uint32_t *ext, uint32_t *top)
+{
+    const uint32_t ys = seg->y_step, xs = seg->x_step;
+    const uint32_t cols = (uint32_t)(b->x1 - b->x0) / xs + 1u;
+    uint32_t j, ri;
+    for (j = 0; j < cols; j++) ext[j] = 0;
+    for (ri = b->first_run; ri != CYL_NONE; ri = seg->runs[ri].next) {
+        const cyl_run *r = &seg->runs[ri];
+        const uint32_t j0 = (uint32_t)(r->x - b->x0) / xs, jy = (uint32_t)(r->y - b->y0) / ys;
+        for (j = j0; j < j0 + r->width; j++) {
+            if (ext[j] == 0) top[j] = jy;   /* rows come in order: the first is the top */
+            ext[j] = jy - top[j] + 1u;
+        }
+    }
+    return cols;
+}
+
+/* Cut blob b's run list before row `cut` (image y): b keeps the rows above, the rows from `cut`
+ * on start the list returned. */
+static uint32_t cut_rows(cyl_segmentation *seg, const cyl_blob *b, uint32_t cut)
+{
+    uint32_t ri, prev = CYL_NONE;
+    /* both parts have rows (the waist's limits), so the cut lies strictly inside the list */
+    for (ri = b->first_run; seg->runs[ri].y < cut; ri = seg->runs[ri].next) prev = ri;
+    seg->runs[prev].next = CYL_NONE;
+    return ri;
+}
+
+/* Index of run `old` after inserting one run after each run of cross[0..nc-1] (ascending). */
+static uint32_t shifted(const uint32_t *cross, uint32_t nc, uint32_t old)
+{
+    uint32_t lo = 0, hi = nc;   /* count the crossings below old */
+    if (old == CYL_NONE) return old;
+    while (lo < hi) {
+        const uint32_t mid = lo + (hi - lo) / 2u;
+        if (cross[mid] < old) lo = mid + 1u; else hi = mid;
+    }
+    return old + lo;
+}
+
+/* Cut blob b's runs before column `cut` (image x): the runs that cross it are split in two, the
+ * new right pieces inserted in the run array after their left pieces (the array stays in (y, x)
+ * order; every index in seg is renumbered). b keeps the left samples; returns the first run of the
+ * right ones. CYL_NONE, with nothing changed, when the run array is full. cross: workspace of the
+ * blob's rows. */
+static uint32_t cut_cols(cyl_segmentation *seg, cyl_blob *b, uint32_t cut, uint32_t *cross)
+{
+    const uint32_t xs = seg->x_step;
+    uint32_t nc = 0, ri, i, k, left_tail = CYL_NONE, right_first = CYL_NONE, right_tail = CYL_NONE, left_first = CYL_NONE;
+    for (ri = b->first_run; ri != CYL_NONE; ri = seg->runs[ri].next) {
+        const cyl_run *r = &seg->runs[ri];
+        if (r->x < cut && r->x + (uint32_t)(r->width - 1u) * xs >= cut) cross[nc++] = ri;
+    }
+    if (seg->n_runs + nc > seg->max_runs) return CYL_NONE;
+    /* open a slot after each crossing run: move the runs up from the top, then renumber */
+    for (i = seg->n_runs; i-- > 0;) {
+        const uint32_t to = shifted(cross, nc, i);
+        if (to != i) seg->runs[to] = seg->runs[i];
+    }
+    seg->n_runs += nc;
+    for (i = 0; i < seg->n_runs; i++) seg->runs[i].next = shifted(cross, nc, seg->runs[i].next);
+    for (k = 0; k < seg->n_blobs; k++) seg->blobs[k].first_run = shifted(cross, nc, seg->blobs[k].first_run);
+    for (k = 0; k < nc; k++) cross[k] += k;   /* their new places (the slot is at +1) */
+    /* deal the runs out, in order, to two lists; a crossing run's right piece takes its slot */
+    for (ri = b->first_run, k = 0; ri != CYL_NONE;) {
+        cyl_run *r = &seg->runs[ri];
+        const uint32_t next = r->next;
+        uint32_t to_left = CYL_NONE, to_right = CYL_NONE;
+        if (k < nc && cross[k] == ri) {
+            cyl_run *q = &seg->runs[ri + 1u];
+            const uint16_t w_left = (uint16_t)((cut - r->x) / xs);
+            *q = *r;
+            q->x = (uint16_t)cut;
+            q->width = (uint16_t)(r->width - w_left);
+            r->width = w_left;
+            to_left = ri;
+            to_right = ri + 1u;
+            k++;
+        } else if (r->x < cut) {
+            to_left = ri;
+        } else {
+            to_right = ri;
+        }
+        if (to_left != CYL_NONE) {
+            if (left_tail == CYL_NONE) left_first = to_left; else seg->runs[left_tail].next = to_left;
+            left_tail = to_left;
+        }
+        if (to_right != CYL_NONE) {
+            if (right_tail == CYL_NONE) right_first = to_right; else seg->runs[right_tail].next = to_right;
+            right_tail = to_right;
+        }
+        ri = next;
+    }
+    seg->runs[left_tail].next = CYL_NONE;
+    seg->runs[right_tail].next = CYL_NONE;
+    b->first_run = left_first;
+    return right_first;
 }
 
 cyl_status cyl_segment_split(cyl_segmentation *seg, const cyl_split_params *p, void *work, size_t work_size,
                              uint32_t *n_split)
 {
     uint32_t i = 0, k, cuts = 0, full = 0;
-    uint32_t *ext, *suf;
+    uint32_t *prof, *aux, *cross;
     int any = 0;
     if (n_split) *n_split = 0;
     if (!seg || !p || !seg->runs || !seg->blobs) return CYL_ERR_ARG;
     if (!(p->min_part_share >= 0.0 && p->min_part_share <= 0.5)) return CYL_ERR_ARG;
+    if (p->axes == 0 || (p->axes & ~(unsigned)(CYL_SPLIT_ROWS | CYL_SPLIT_COLUMNS))) return CYL_ERR_ARG;
     for (k = 0; k < CYL_MAX_CLASSES; k++) {
         if (!(p->waist_ratio[k] >= 0.0 && p->waist_ratio[k] <= 1.0)) return CYL_ERR_ARG;
         any |= p->waist_ratio[k] > 0.0;
     }
     if (!any || seg->n_blobs == 0) return CYL_OK;
     if (!work || work_size < cyl_segment_split_work_size(seg)) return CYL_ERR_SIZE;
-    ext = (uint32_t *)work;
-    suf = ext + grid_rows(seg);
-    /* a blob that was cut is examined again (its upper part), and the lower parts appended at the
-     * end in turn: a part may have a waist of its own */
+    {
+        const uint32_t rows = grid_rows(seg), cols = grid_cols(seg), n = rows > cols ? rows : cols;
+        prof = (uint32_t *)work;
+        aux = prof + n;
+        cross = aux + n;
+    }
+    /* a blob that was cut is examined again (its first part), and the second parts appended at
+     * the end in turn: a part may have a waist of its own */
     while (i < seg->n_blobs) {
         cyl_blob *b = &seg->blobs[i];
         const double ratio = p->waist_ratio[b->cls];
-        uint32_t cut = ratio > 0.0 ? find_waist(seg, b, ratio, p, ext, suf) : 0u, ri, prev = CYL_NONE;
-        if (!cut || seg->n_blobs >= seg->max_blobs) {
-            full |= cut != 0u;
+        uint32_t jr = 0, jc = 0, rn = 0, rd = 1, cn = 0, cd = 1, second = CYL_NONE;
+        if (ratio > 0.0 && (p->axes & CYL_SPLIT_ROWS)) {
+            const uint32_t n = row_profile(seg, b, prof);
+            jr = profile_waist(prof, aux, n, part_need(p, n), ratio, &rn, &rd);
+        }
+        if (ratio > 0.0 && (p->axes & CYL_SPLIT_COLUMNS)) {
+            const uint32_t n = col_profile(seg, b, prof, aux);
+            jc = profile_waist(prof, aux, n, part_need(p, n), ratio, &cn, &cd);
+        }
+        if (jr && jc) {   /* both axes have a waist: the narrower share (rows on a tie) */
+            if ((uint64_t)cn * rd < (uint64_t)rn * cd) jr = 0; else jc = 0;
+        }
+        if ((!jr && !jc) || seg->n_blobs >= seg->max_blobs) {
+            full |= (jr || jc) ? CYL_SEG_BLOBS_FULL : 0u;
             i++;
             continue;
         }
-        /* both parts have rows (find_waist), so the cut lies strictly inside the run list */
-        for (ri = b->first_run; seg->runs[ri].y < cut; ri = seg->runs[ri].next) prev = ri;
-        seg->runs[prev].next = CYL_NONE;
+        if (jr) {
+            second = cut_rows(seg, b, b->y0 + jr * seg->y_step);
+        } else {
+            second = cut_cols(seg, b, b->x0 + jc * seg->x_step, cross);
+            if (second == CYL_NONE) {   /* no room for the split runs */
+                full |= CYL_SEG_RUNS_FULL;
+                i++;
+                continue;
+            }
+        }
         {
             cyl_blob *nb = &seg->blobs[seg->n_blobs++];
             *nb = *b;
             nb->flags |= CYL_BLOB_SPLIT;
-            blob_from_runs(seg, nb, ri);
+            blob_from_runs(seg, nb, second);
         }
         b->flags |= CYL_BLOB_SPLIT;
         blob_from_runs(seg, b, b->first_run);
@@ -1061,7 +1215,7 @@ cyl_status cyl_segment_split(cyl_segmentation *seg, const cyl_split_params *p, v
     }
     if (n_split) *n_split = cuts;
     if (full) {
-        seg->truncated |= CYL_SEG_BLOBS_FULL;
+        seg->truncated |= full;
         return CYL_TRUNCATED;
     }
     return CYL_OK;

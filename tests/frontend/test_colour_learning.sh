@@ -91,6 +91,7 @@ expect label_outside 1 "labels/a.txt:1: box reaches outside the image" -- "$B/cy
 rm "$T/bad/labels/a.txt"
 expect label_missing 1 "a.jpg: no label file" -- "$B/cyl-train" learn -q -o "$T/x.cylt" --class cone=0 "$T/bad/images/a.jpg"
 expect learn_unknown_option 2 "unknown argument '--fpp'" -- "$B/cyl-train" learn -o "$T/x.cylt" --fpp 0.1 --class a=0 x.jpg
+expect learn_bad_split_axes 2 "--split-axes: 'diagonal' is not rows, columns or both" -- "$B/cyl-train" learn -o "$T/x.cylt" --split-axes diagonal --class a=0 x.jpg
 expect learn_bad_class 2 "--class: expected NAME=LABEL" -- "$B/cyl-train" learn -o "$T/x.cylt" --class cone x.jpg
 expect score_no_table 2 "--table is required" -- "$B/cyl-score" --class cone=0 x.jpg
 printf 'classes:\n  cone:\n    min_fil: 0.3\n' > "$T/c.yaml"

@@ -409,7 +409,7 @@ static void test_bruteforce_random(void **state)
     static const cyl_pixfmt fmts[] = { CYL_FMT_YUYV, CYL_FMT_UYVY, CYL_FMT_NV12, CYL_FMT_I420, CYL_FMT_YUV444P };
     static const uint8_t speck[5][3] = { { ORANGE }, { GREEN }, { 200, 120, 170 }, { GREY }, { 150, 200, 170 } };
     test_rng rng;
-    int iter, total_blobs = 0, weak_runs = 0;
+    int iter, total_blobs = 0, weak_runs = 0, weak_alone_blobs = 0;
     uint32_t max_runs = 200000, max_blobs = 20000;
     size_t ms = cyl_segment_mem_size(max_runs, max_blobs);
     void *mem = malloc(ms);
@@ -475,13 +475,15 @@ static void test_bruteforce_random(void **state)
             p.cls[k].merge_gap_px = -1;
             p.cls[k].min_area = (uint32_t)test_rng_int(&rng, 0, 6);
         }
+        /* sometimes a weak component alone is a blob of green once large enough */
+        if (test_rng_int(&rng, 0, 1)) p.cls[1].weak_alone_min_area = (uint32_t)test_rng_int(&rng, 1, 60);
         assert_int_equal(cyl_segment(&table, &img, &p, &seg), CYL_OK);
         n = ref_segment(&table, &img, &p, ref, 20000, NULL);
         assert_int_equal(n, (int)seg.n_blobs);
         for (i = 0; i < n; i++) {
             const cyl_blob *b = &seg.blobs[i];
             const ref_blob *r = &ref[i];
-            uint32_t ri, cnt = 0, area = 0;
+            uint32_t ri, cnt = 0, area = 0, strong = 0;
             assert_int_equal(b->cls, r->cls);
             assert_int_equal(b->area, r->area);
             assert_int_equal(b->x0, r->x0); assert_int_equal(b->x1, r->x1);
@@ -495,11 +497,16 @@ static void test_bruteforce_random(void **state)
                 /* runs keep their own class: the blob's, or its weak class's */
                 assert_true(seg.runs[ri].cls == b->cls || table.weak_of[seg.runs[ri].cls] == b->cls);
                 weak_runs += seg.runs[ri].cls != b->cls;
+                strong += seg.runs[ri].cls == b->cls;
                 area += seg.runs[ri].width;
                 cnt++;
             }
             assert_int_equal(cnt, b->n_runs);
             assert_int_equal(area, b->area);
+            if (!strong) {   /* weak runs alone: only where allowed, and large enough */
+                assert_true(p.cls[b->cls].weak_alone_min_area > 0 && b->area >= p.cls[b->cls].weak_alone_min_area);
+                weak_alone_blobs++;
+            }
         }
         total_blobs += n;
         free(buf);
@@ -507,6 +514,7 @@ static void test_bruteforce_random(void **state)
     }
     assert_true(total_blobs > 3000); /* the frames were not trivially empty */
     assert_true(weak_runs > 500);    /* and weak runs joined blobs */
+    assert_true(weak_alone_blobs > 100);   /* and weak components alone were kept */
     free(mem);
     free(ref);
 }
@@ -1035,7 +1043,7 @@ static void draw_taper(canvas *c, int32_t cx, int32_t ytop, int32_t rows, int32_
 }
 
 /* The segmentation's invariants after a split: every run of a blob's list is labelled with the
- * blob, runs in (y, x) order within a list, the statistics that the runs give (area, box, run
+ * blob, runs in (y, x) order within a list and in the array, the statistics that the runs give (area, box, run
  * count, centroid), the blobs' order, class_first and class_count. */
 static void check_split_consistent(const cyl_segmentation *seg)
 {
@@ -1072,7 +1080,13 @@ static void check_split_consistent(const cyl_segmentation *seg)
         if (cnt[b->cls]++ == 0) assert_int_equal(seg->class_first[b->cls], k);
     }
     for (k = 0; k < CYL_MAX_CLASSES; k++) assert_int_equal(seg->class_count[k], cnt[k]);
-    for (ri = 0, k = 0; ri < seg->n_runs; ri++) k += seg->runs[ri].blob != CYL_NONE;
+    for (ri = 0, k = 0; ri < seg->n_runs; ri++) {
+        k += seg->runs[ri].blob != CYL_NONE;
+        if (ri > 0) {   /* the array in (y, x) order */
+            const cyl_run *a = &seg->runs[ri - 1], *r = &seg->runs[ri];
+            assert_true(r->y > a->y || (r->y == a->y && r->x > a->x));
+        }
+    }
     assert_int_equal(k, labelled);
 }
 
@@ -1150,7 +1164,7 @@ static void test_split_stacked_cones(void **state)
     fx_close(&g);
 }
 
-/* Single shapes have no waist, even at a ratio of 1: a cylinder (rectangle), a cone, one upside
+/* Single shapes have no waist along rows or columns, even at a ratio of 1: a cylinder (rectangle), a cone, one upside
  * down, a ball, a box seen from a corner (a hexagon-like taper up then down). */
 static void test_split_single_shapes(void **state)
 {
@@ -1160,7 +1174,8 @@ static void test_split_single_shapes(void **state)
     unsigned k;
     (void)state;
     for (k = 0; k < CYL_MAX_CLASSES; k++) sp.waist_ratio[k] = 1.0;
-    sp.min_part_rows = 1;
+    sp.axes = CYL_SPLIT_ROWS | CYL_SPLIT_COLUMNS;
+    sp.min_part_lines = 1;
     sp.min_part_share = 0.0;
     fx_open(&f, 240, 100, 8000, 64);
     canvas_rect(&f.c, 5, 10, 20, 60, ORANGE);
@@ -1174,6 +1189,63 @@ static void test_split_single_shapes(void **state)
     assert_int_equal(fx_split(&f, &sp, &n_split), CYL_OK);
     assert_int_equal(n_split, 0);
     assert_int_equal(f.seg.n_blobs, 5);
+    fx_close(&f);
+}
+
+/* Two standing cones side by side, their bases touching in the bottom row: one blob, no row waist,
+ * a column waist where the bases meet. Cut along columns, each part is its cone (to the column the
+ * cut falls on: the two columns either side of the contact are equally narrow). */
+static void test_split_side_by_side(void **state)
+{
+    fixture f;
+    cyl_split_params sp = cyl_split_params_default();
+    uint32_t n_split = 99, area_a, area_b;
+    (void)state;
+    fx_open(&f, 120, 80, 4000, 64);
+    draw_taper(&f.c, 40, 20, 40, 4, 30, ORANGE);   /* columns 25..54 at the bottom row (59) */
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    area_a = f.seg.blobs[0].area;
+    canvas_fill(&f.c, GREY);
+    draw_taper(&f.c, 70, 20, 40, 4, 30, ORANGE);   /* columns 55..84 */
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    area_b = f.seg.blobs[0].area;
+    draw_taper(&f.c, 40, 20, 40, 4, 30, ORANGE);
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_blobs, 1);
+    assert_int_equal(f.seg.blobs[0].area, area_a + area_b);
+    sp.waist_ratio[0] = 0.5;
+    assert_int_equal(fx_split(&f, &sp, &n_split), CYL_OK);   /* rows only (the default): no waist */
+    assert_int_equal(n_split, 0);
+    sp.axes = CYL_SPLIT_ROWS | CYL_SPLIT_COLUMNS;
+    assert_int_equal(fx_split(&f, &sp, &n_split), CYL_OK);
+    assert_int_equal(n_split, 1);
+    assert_int_equal(f.seg.n_blobs, 2);
+    check_split_consistent(&f.seg);
+    {
+        /* blobs sorted by area: find which part is the left one */
+        const cyl_blob *l = f.seg.blobs[0].x0 < f.seg.blobs[1].x0 ? &f.seg.blobs[0] : &f.seg.blobs[1];
+        const cyl_blob *r = l == &f.seg.blobs[0] ? &f.seg.blobs[1] : &f.seg.blobs[0];
+        assert_int_equal(l->x0, 25); assert_int_equal(r->x1, 84);
+        assert_true(l->x1 == 53 || l->x1 == 54);
+        assert_int_equal(r->x0, l->x1 + 1);
+        /* the contact column holds at most the bottom rows' samples */
+        assert_true(abs((int)l->area - (int)area_a) <= 2 && abs((int)r->area - (int)area_b) <= 2);
+        assert_true(fabs(l->cx_px - 39.5) < 0.5 && fabs(r->cx_px - 69.5) < 0.5);
+        assert_int_equal(l->flags, CYL_BLOB_SPLIT);
+        assert_int_equal(r->flags, CYL_BLOB_SPLIT);
+    }
+    fx_close(&f);
+    /* a run array with no room for the crossing runs' right pieces: no cut, and it says so */
+    fx_open(&f, 120, 80, 79, 64);   /* 39 rows of two runs, the bottom row one */
+    draw_taper(&f.c, 40, 20, 40, 4, 30, ORANGE);
+    draw_taper(&f.c, 70, 20, 40, 4, 30, ORANGE);
+    assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
+    assert_int_equal(f.seg.n_runs, 79);
+    assert_int_equal(fx_split(&f, &sp, &n_split), CYL_TRUNCATED);
+    assert_int_equal(n_split, 0);
+    assert_int_equal(f.seg.n_blobs, 1);
+    assert_true(f.seg.truncated & CYL_SEG_RUNS_FULL);
+    check_split_consistent(&f.seg);
     fx_close(&f);
 }
 
@@ -1213,108 +1285,176 @@ static void test_split_merged_gap(void **state)
     fx_close(&f);
 }
 
-/* Brute-force reference: the parts a width profile (one run a sampled row, rows a..b) splits into,
- * found by trying every row: the least share ext[j] / min(widest above, widest below), below the
- * ratio, the upper row on a tie, each part at least `need` rows; then each part again. Writes the
- * parts' first rows to out (in any order); returns their count. */
-static unsigned ref_split(const uint32_t *w, unsigned a, unsigned b, double ratio, const cyl_split_params *sp,
-                          unsigned *out)
+/* Brute-force reference on a mask of grid samples (m[gy * GW + gx], 1 = the part's): the row
+ * profile (each grid row's first to last sample, in samples) and the column profile (each grid
+ * column's first to last sampled row with a sample, in rows); every row and column tried: the least
+ * share ext / min(widest before, widest after), below the ratio, the first on a tie, each part at
+ * least `need` rows (columns); the row cut when both axes have one and its share is not larger;
+ * then each part again. Appends each final part's (x0, y0, area) key to out; returns their count. */
+enum { GW = 240, GH = 120 };
+
+static int ref_profile_cut(const uint32_t *ext, unsigned n, double ratio, const cyl_split_params *sp,
+                           uint32_t *num, uint32_t *den)
 {
-    const unsigned rows = b - a + 1u;
-    unsigned need = (unsigned)ceil(sp->min_part_share * rows), j, best = 0, i;
+    unsigned need = (unsigned)ceil(sp->min_part_share * n), j, i, best = 0;
     uint32_t be = 0, bm = 0;
-    if (need < sp->min_part_rows) need = sp->min_part_rows;
+    if (need < sp->min_part_lines) need = sp->min_part_lines;
     if (need < 1u) need = 1u;
-    if (rows >= 2u * need) {
-        for (j = need; j + need <= rows; j++) {
-            uint32_t above = 0, below = 0, m;
-            for (i = 0; i < j; i++) if (w[a + i] > above) above = w[a + i];
-            for (i = j + 1u; i < rows; i++) if (w[a + i] > below) below = w[a + i];
-            m = above < below ? above : below;
-            if (m == 0 || (double)w[a + j] >= ratio * m) continue;
-            if (best == 0 || (uint64_t)w[a + j] * bm < (uint64_t)be * m) { best = j; be = w[a + j]; bm = m; }
-        }
+    if (n < 2u * need) return 0;
+    for (j = need; j + need <= n; j++) {
+        uint32_t before = 0, after = 0, m;
+        for (i = 0; i < j; i++) if (ext[i] > before) before = ext[i];
+        for (i = j + 1u; i < n; i++) if (ext[i] > after) after = ext[i];
+        m = before < after ? before : after;
+        if (m == 0 || ext[j] == 0 || (double)ext[j] >= ratio * m) continue;
+        if (best == 0 || (uint64_t)ext[j] * bm < (uint64_t)be * m) { best = j; be = ext[j]; bm = m; }
     }
-    if (!best) { out[0] = a; return 1; }
-    i = ref_split(w, a, a + best - 1u, ratio, sp, out);
-    return i + ref_split(w, a + best, b, ratio, sp, out + i);
+    *num = be; *den = bm;
+    return (int)best;
 }
 
-static int cmp_u(const void *x, const void *y)
+static unsigned ref_split_mask(const uint8_t *m, double ratio, const cyl_split_params *sp, uint32_t ys,
+                               uint32_t xs, uint64_t *out)
 {
-    const unsigned a = *(const unsigned *)x, b = *(const unsigned *)y;
+    int gx, gy, x0 = GW, x1 = -1, y0 = GH, y1 = -1, jr = 0, jc = 0;
+    uint32_t ext[GW > GH ? GW : GH] = { 0 }, rn = 0, rd = 1, cn = 0, cd = 1, area = 0;
+    unsigned n;
+    uint8_t *a, *b;
+    for (gy = 0; gy < GH; gy++)
+        for (gx = 0; gx < GW; gx++)
+            if (m[gy * GW + gx]) {
+                if (gx < x0) x0 = gx;
+                if (gx > x1) x1 = gx;
+                if (gy < y0) y0 = gy;
+                if (gy > y1) y1 = gy;
+                area++;
+            }
+    if (sp->axes & CYL_SPLIT_ROWS) {
+        for (gy = y0; gy <= y1; gy++) {
+            int lo = -1, hi = -1;
+            for (gx = x0; gx <= x1; gx++) if (m[gy * GW + gx]) { if (lo < 0) lo = gx; hi = gx; }
+            ext[gy - y0] = lo < 0 ? 0u : (uint32_t)(hi - lo + 1);
+        }
+        jr = ref_profile_cut(ext, (unsigned)(y1 - y0 + 1), ratio, sp, &rn, &rd);
+    }
+    if (sp->axes & CYL_SPLIT_COLUMNS) {
+        for (gx = x0; gx <= x1; gx++) {
+            int lo = -1, hi = -1;
+            for (gy = y0; gy <= y1; gy++) if (m[gy * GW + gx]) { if (lo < 0) lo = gy; hi = gy; }
+            ext[gx - x0] = lo < 0 ? 0u : (uint32_t)(hi - lo + 1);
+        }
+        jc = ref_profile_cut(ext, (unsigned)(x1 - x0 + 1), ratio, sp, &cn, &cd);
+    }
+    if (jr && jc) {
+        if ((uint64_t)cn * rd < (uint64_t)rn * cd) jr = 0; else jc = 0;
+    }
+    if (!jr && !jc) {
+        out[0] = ((uint64_t)(y0 * ys) << 40) | ((uint64_t)(x0 * xs) << 24) | area;
+        return 1;
+    }
+    a = (uint8_t *)calloc(GW * GH, 1);
+    b = (uint8_t *)calloc(GW * GH, 1);
+    for (gy = y0; gy <= y1; gy++)
+        for (gx = x0; gx <= x1; gx++)
+            if (m[gy * GW + gx]) {
+                const int first = jr ? gy < y0 + jr : gx < x0 + jc;
+                (first ? a : b)[gy * GW + gx] = 1;
+            }
+    n = ref_split_mask(a, ratio, sp, ys, xs, out);
+    n += ref_split_mask(b, ratio, sp, ys, xs, out + n);
+    free(a);
+    free(b);
+    return n;
+}
+
+static int cmp_u64(const void *x, const void *y)
+{
+    const uint64_t a = *(const uint64_t *)x, b = *(const uint64_t *)y;
     return (a > b) - (a < b);
 }
 
-/* Random stacks of runs (random widths, or a random walk of widths), sampled every row and every
- * second row: the parts cyl_segment_split() makes are those of the brute-force reference. */
+/* Random shapes, sampled every row and every second row and column, cut along rows, columns or both: the
+ * parts cyl_segment_split() makes are those of the brute-force reference on the shapes' masks.
+ * Each shape is a stack of centred runs (one a row, random widths or a random walk of them) or a
+ * row of centred columns (one a column, random heights or a random walk), so it is 4-connected
+ * through its centre line; rows or columns with gaps appear when the stack is read the other
+ * way. Every run and every sample survives, once: the parts' areas add up to the shapes'. */
 static void test_split_bruteforce_random(void **state)
 {
-    enum { W = 240, H = 120, SHAPES = 4, MAXR = 110 };
+    enum { SHAPES = 4 };
     fixture f;
     test_rng rng;
-    unsigned trial, total_cuts = 0;
+    unsigned trial, total_cuts = 0, col_trials_cut = 0;
+    uint8_t *mask = (uint8_t *)malloc(GW * GH);
     (void)state;
     test_rng_seed(&rng, 20261205u);
-    fx_open(&f, W, H, 20000, 256);
-    for (trial = 0; trial < 300; trial++) {
-        uint32_t widths[SHAPES][H], n_split, expect_cuts = 0;
-        unsigned ytop[SHAPES], nrows[SHAPES], s, ys = (trial & 1u) ? 2u : 1u;
-        unsigned exp_y0[SHAPES * MAXR], got_y0[256], shape_parts[SHAPES], n_exp = 0, n_got = 0, k;
+    fx_open(&f, GW, GH, 40000, 512);
+    for (trial = 0; trial < 400; trial++) {
+        const uint32_t ys = (trial & 1u) ? 2u : 1u, xs = (trial & 2u) ? 2u : 1u;
+        uint32_t n_split, area_all = 0, area_parts = 0;
+        uint64_t expect[512], got[512];
+        unsigned n_exp = 0, n_got = 0, s, k;
         cyl_split_params sp = cyl_split_params_default();
         sp.waist_ratio[0] = 0.2 + 0.7 * test_rng_uniform(&rng);
-        sp.min_part_rows = (uint16_t)test_rng_int(&rng, 1, 5);
+        sp.min_part_lines = (uint16_t)test_rng_int(&rng, 1, 5);
         sp.min_part_share = 0.3 * test_rng_uniform(&rng);
+        sp.axes = (unsigned)test_rng_int(&rng, 1, 3);
         canvas_fill(&f.c, GREY);
         f.p.y_step = (uint16_t)ys;
+        f.p.x_step = (uint16_t)xs;
+        f.p.min_run_px = (uint16_t)(xs == 1u ? 3u : 2u);
         for (s = 0; s < SHAPES; s++) {
-            const int walk = (int)test_rng_int(&rng, 0, 1);
-            uint32_t wcur = (uint32_t)test_rng_int(&rng, 4, 50);
-            unsigned j;
-            ytop[s] = (unsigned)test_rng_int(&rng, 0, 20) * 2u;
-            nrows[s] = (unsigned)test_rng_int(&rng, 2, (H - 1 - (int)ytop[s]) / 2) * 2u;
-            for (j = 0; j < nrows[s]; j++) {
+            const int walk = (int)test_rng_int(&rng, 0, 1), by_cols = (int)test_rng_int(&rng, 0, 1);
+            const int32_t cx = 30 + 60 * (int32_t)s;
+            const int32_t len = by_cols ? (int32_t)test_rng_int(&rng, 4, 54) : (int32_t)test_rng_int(&rng, 4, 100);
+            const int32_t top = (int32_t)test_rng_int(&rng, 0, 10) * 2;
+            int32_t j, cur = (int32_t)test_rng_int(&rng, 4, 50);
+            for (j = 0; j < len; j++) {
                 if (walk) {
-                    wcur = (uint32_t)((int)wcur + (int)test_rng_int(&rng, -6, 6));
-                    if (wcur < 4) wcur = 4;
-                    if (wcur > 56) wcur = 56;
+                    cur += (int32_t)test_rng_int(&rng, -6, 6);
+                    if (cur < 4) cur = 4;
+                    if (cur > 54) cur = 54;
                 } else {
-                    wcur = (uint32_t)test_rng_int(&rng, 4, 56);
+                    cur = (int32_t)test_rng_int(&rng, 4, 54);
                 }
-                widths[s][j] = wcur;
-                canvas_rect(&f.c, 30 + 60 * (int32_t)s - (int32_t)wcur / 2, (int32_t)(ytop[s] + j), (int32_t)wcur, 1,
-                            ORANGE);
+                if (by_cols) canvas_rect(&f.c, cx - len / 2 + j, 60 - cur, 1, 2 * cur, ORANGE);   /* rows 6..113 */
+                else canvas_rect(&f.c, cx - cur / 2, top + j, cur, 1, ORANGE);
             }
         }
         assert_int_equal(fx_run(&f, CYL_FMT_YUV444P, 0), CYL_OK);
         assert_int_equal(f.seg.n_blobs, SHAPES);
-        /* reference on the sampled rows (even rows when ys = 2: ytop is even) */
-        for (s = 0; s < SHAPES; s++) {
-            uint32_t sw[H];
-            unsigned m = 0, j, parts[H], np;
-            for (j = 0; j < nrows[s]; j += ys) sw[m++] = widths[s][j];
-            np = ref_split(sw, 0, m - 1u, sp.waist_ratio[0], &sp, parts);
-            expect_cuts += np - 1u;
-            shape_parts[s] = np;
-            for (j = 0; j < np; j++) exp_y0[n_exp++] = ytop[s] + parts[j] * ys + 1000u * s;
+        /* the reference, on each blob's samples as a mask on the grid */
+        for (k = 0; k < f.seg.n_blobs; k++) {
+            uint32_t ri;
+            memset(mask, 0, GW * GH);
+            for (ri = f.seg.blobs[k].first_run; ri != CYL_NONE; ri = f.seg.runs[ri].next) {
+                const cyl_run *r = &f.seg.runs[ri];
+                uint32_t q;
+                for (q = 0; q < r->width; q++) mask[(r->y / ys) * GW + r->x / xs + q] = 1;
+            }
+            area_all += f.seg.blobs[k].area;
+            n_exp += ref_split_mask(mask, sp.waist_ratio[0], &sp, ys, xs, expect + n_exp);
         }
         assert_int_equal(fx_split(&f, &sp, &n_split), CYL_OK);
-        assert_int_equal(n_split, expect_cuts);
+        assert_int_equal(n_split, n_exp - SHAPES);
         total_cuts += n_split;
+        col_trials_cut += n_split > 0 && (sp.axes & CYL_SPLIT_COLUMNS);
         check_split_consistent(&f.seg);
         for (k = 0; k < f.seg.n_blobs; k++) {
             const cyl_blob *b = &f.seg.blobs[k];
-            const unsigned s_of = (unsigned)(b->x0 + b->x1) / 2u / 60u;   /* shape s lies around 30 + 60 s */
-            assert_int_equal(!!(b->flags & CYL_BLOB_SPLIT), shape_parts[s_of] > 1u);
-            got_y0[n_got++] = b->y0 + 1000u * s_of;
+            got[n_got++] = ((uint64_t)b->y0 << 40) | ((uint64_t)b->x0 << 24) | b->area;
+            area_parts += b->area;
         }
+        assert_int_equal(area_parts, area_all);
         assert_int_equal(n_got, n_exp);
-        qsort(exp_y0, n_exp, sizeof exp_y0[0], cmp_u);
-        qsort(got_y0, n_got, sizeof got_y0[0], cmp_u);
-        for (k = 0; k < n_got; k++) assert_int_equal(got_y0[k], exp_y0[k]);
+        qsort(expect, n_exp, sizeof expect[0], cmp_u64);
+        qsort(got, n_got, sizeof got[0], cmp_u64);
+        for (k = 0; k < n_got; k++) assert_true(got[k] == expect[k]);
     }
-    /* the trials exercised cuts, recursive ones included */
-    assert_true(total_cuts > 300);
+    /* the trials exercised cuts, recursive and column ones included */
+    assert_true(total_cuts > 400);
+    assert_true(col_trials_cut > 100);
+    free(mask);
     fx_close(&f);
 }
 
@@ -1337,8 +1477,8 @@ static void test_split_capacity_and_arguments(void **state)
     assert_true(f.seg.truncated & CYL_SEG_BLOBS_FULL);
     assert_int_equal(f.seg.blobs[0].flags, 0);
     check_split_consistent(&f.seg);
-    /* the workspace: two counters a sampled row (100 rows) */
-    assert_int_equal(cyl_segment_split_work_size(&f.seg), 2u * 100u * sizeof(uint32_t));
+    /* the workspace: two counters a sampled row or column (100 rows, 80 columns), one a row */
+    assert_int_equal(cyl_segment_split_work_size(&f.seg), (2u * 100u + 100u) * sizeof(uint32_t));
     assert_int_equal(cyl_segment_split_work_size(NULL), 0);
     assert_int_equal(cyl_segment_split(&f.seg, &sp, small, sizeof small, &n_split), CYL_ERR_SIZE);
     assert_int_equal(cyl_segment_split(&f.seg, &sp, NULL, 0, &n_split), CYL_ERR_SIZE);
@@ -1352,6 +1492,11 @@ static void test_split_capacity_and_arguments(void **state)
     assert_int_equal(cyl_segment_split(&f.seg, &sp, small, sizeof small, &n_split), CYL_ERR_ARG);
     sp.waist_ratio[3] = 0.0;
     sp.min_part_share = 0.6;
+    assert_int_equal(cyl_segment_split(&f.seg, &sp, small, sizeof small, &n_split), CYL_ERR_ARG);
+    sp.min_part_share = 0.15;
+    sp.axes = 0;
+    assert_int_equal(cyl_segment_split(&f.seg, &sp, small, sizeof small, &n_split), CYL_ERR_ARG);
+    sp.axes = 4;
     assert_int_equal(cyl_segment_split(&f.seg, &sp, small, sizeof small, &n_split), CYL_ERR_ARG);
     fx_close(&f);
 }
@@ -1381,6 +1526,7 @@ int main(void)
         cmocka_unit_test(test_bands_join_identical),
         cmocka_unit_test(test_split_stacked_cones),
         cmocka_unit_test(test_split_single_shapes),
+        cmocka_unit_test(test_split_side_by_side),
         cmocka_unit_test(test_split_merged_gap),
         cmocka_unit_test(test_split_bruteforce_random),
         cmocka_unit_test(test_split_capacity_and_arguments),

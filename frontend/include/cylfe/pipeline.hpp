@@ -59,6 +59,11 @@ uint32_t model_classes(const DetectorConfig &cfg);
 // class has a waist ratio); work grows as needed. Returns the status (CYL_TRUNCATED: blob capacity).
 cyl_status split_blobs(const DetectorConfig &cfg, cyl_segmentation &seg, std::vector<uint8_t> &work);
 
+// The waist cut's axes by name, "rows", "columns" or "both" (CYL_SPLIT_* bits; 0 for another
+// name), and back.
+unsigned split_axes_from_name(const std::string &name);
+const char *split_axes_name(unsigned axes);
+
 // The gates that need no camera (area, aspect, fill, mask) on one blob of a frame.
 bool blob_passes(const DetectorConfig &cfg, const cyl_blob &b, uint32_t frame_width, uint32_t frame_height);
 // The mask's verdict on a point of a frame (true: keep; no mask, or one of another size: true).

@@ -10,7 +10,8 @@
  * Weak classes (hysteresis, cyl_colortable_set_weak): the runs of a class W
  * that is the weak evidence of class S connect with S's runs (4-connected,
  * including side by side in a row) and with each other; a component keeps
- * only if it holds at least one run of S, and its blob has class S. Learned
+ * only if it holds at least one run of S (or, when S's weak_alone_min_area is
+ * set, has at least that many samples), and its blob has class S. Learned
  * tables use this for colours that are likely but not certain (the pale top
  * of a lit ball next to its saturated side). Runs keep their own class.
  *
@@ -85,6 +86,9 @@ typedef struct cyl_class_params {
                                  px apart along x and along y (gap 0 = boxes touch); < 0 disables (default 3) */
     double merge_min_density; /* ... and the merged area / merged bounding-box area (in samples) is at
                                  least this, 0..1 (default 0.5) */
+    uint32_t weak_alone_min_area; /* with a weak class: a component of the class's weak runs alone
+                                 (no run of the class itself) is a blob of the class when it has at
+                                 least this many samples, after merging (0: never, the default) */
 } cyl_class_params;
 
 typedef struct cyl_segment_params {
@@ -178,35 +182,48 @@ cyl_status cyl_segment_join(const cyl_colortable *t, const cyl_image *img, const
                             cyl_segmentation *seg);
 
 /* ---- splitting blobs at a waist ---------------------------------------------
- * Two landmarks of one class that touch in the image, one above the other (a far cone whose
- * base meets the tip of a nearer one), form one blob. Its rows' extents narrow between the
- * two: cyl_segment_split() cuts a blob at the row where the extent (first to last sample of
- * the row) is smallest against the widest row above it and the widest row below it, when that
- * share is below the class's waist_ratio and both parts keep enough rows. The parts are split
- * again if they have a waist of their own. A single cylinder, box, ball or cone (extents that
- * grow, stay or shrink steadily) has no waist. */
+ * Two landmarks of one class that touch in the image form one blob: one above the other (a far
+ * cone whose base meets the tip of a nearer one), or side by side. Between the two the blob
+ * narrows. cyl_segment_split() looks at the blob's row profile (each sampled row's extent, first
+ * to last sample of the row) and its column profile (each sampled column's extent, first to last
+ * sampled row with a sample), and cuts at the row or column whose extent is the smallest share
+ * of the widest entry before it and the widest after it, when that share is below the class's
+ * waist_ratio and both parts keep enough rows (columns). The parts are split again if they have
+ * a waist of their own. A single cylinder, box, ball or cone (profiles that grow, stay or shrink
+ * steadily, or rise to one peak) has no waist. Rows or columns without a sample (the gap
+ * between merged pieces) are never a cut. */
+#define CYL_SPLIT_ROWS    0x1u   /* cut between rows (landmarks one above the other) */
+#define CYL_SPLIT_COLUMNS 0x2u   /* cut between columns (side by side) */
+
 typedef struct cyl_split_params {
-    double waist_ratio[CYL_MAX_CLASSES]; /* split a blob of class k at a row whose extent is
-                                            below this share of the widest rows both above and
-                                            below it, 0..1 (0: never; default 0) */
-    uint16_t min_part_rows;              /* each part keeps at least this many sampled rows
-                                            (default 4) */
-    double min_part_share;               /* ... and this share of the blob's rows, 0..0.5
+    double waist_ratio[CYL_MAX_CLASSES]; /* split a blob of class k at a row (column) whose extent
+                                            is below this share of the widest both before and
+                                            after it, 0..1 (0: never; default 0) */
+    unsigned axes;                       /* CYL_SPLIT_ROWS and/or CYL_SPLIT_COLUMNS (default
+                                            CYL_SPLIT_ROWS) */
+    uint16_t min_part_lines;             /* each part keeps at least this many sampled rows (a
+                                            row cut) or columns (a column cut) (default 4) */
+    double min_part_share;               /* ... and this share of the blob's, 0..0.5
                                             (default 0.15) */
 } cyl_split_params;
 
 /* Defaults described above (every waist_ratio 0: nothing is split). */
 cyl_split_params cyl_split_params_default(void);
 
-/* Bytes of workspace cyl_segment_split() needs after a segmentation of this frame (two
- * counters a sampled row of seg's grid). */
+/* Bytes of workspace cyl_segment_split() needs after a segmentation of this frame (two counters
+ * a sampled row or column, whichever are more, and one a sampled row). */
 size_t cyl_segment_split_work_size(const cyl_segmentation *seg);
 
 /* Split seg's blobs at their waists (above), in place: each part becomes a blob with its own
- * statistics and the flag CYL_BLOB_SPLIT, the blobs are sorted again (seg->blobs' order), and
- * runs, class_first and class_count follow. *n_split (may be NULL): cuts made. CYL_TRUNCATED
- * when seg->max_blobs stopped a cut (seg->truncated gains CYL_SEG_BLOBS_FULL); CYL_ERR_ARG for
- * bad parameters, CYL_ERR_SIZE for a workspace smaller than cyl_segment_split_work_size(). */
+ * statistics and the flag CYL_BLOB_SPLIT (n_components and CYL_BLOB_MERGED stay the whole's),
+ * the blobs are sorted again (seg->blobs' order), and runs, class_first and class_count follow.
+ * A column cut splits the runs that cross it in two: the right pieces are inserted into
+ * seg->runs after their left ones (the array stays in (y, x) order; run indices change). The
+ * cut's edges are not colour edges: the image estimator and the sub-pixel edges treat them as
+ * they treat any run end. *n_split (may be NULL): cuts made. CYL_TRUNCATED when seg->max_blobs
+ * or seg->max_runs stopped a cut (seg->truncated gains CYL_SEG_BLOBS_FULL or
+ * CYL_SEG_RUNS_FULL); CYL_ERR_ARG for bad parameters, CYL_ERR_SIZE for a workspace smaller than
+ * cyl_segment_split_work_size(). */
 cyl_status cyl_segment_split(cyl_segmentation *seg, const cyl_split_params *p, void *work, size_t work_size,
                              uint32_t *n_split);
 

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The detector config's waist cut (split_waist, docs/formats.md): read per class, written back by
+// The detector config's blob rules beyond the gates (docs/formats.md): weak_alone_min_area_px per
+// class, and the waist cut (split_waist per class, split_axes): read, written back by
 // detector_config_yaml, a value out of range named by file, line and field; and the Detector
 // turning two painted cones, the far one standing on the near one's tip, into two observations
 // with the cut and one without.
@@ -37,7 +38,7 @@ std::string load(const std::string &text, DetectorConfig &c)
 
 } // namespace
 
-TEST(SplitConfig, ReadWrittenBackAndChecked)
+TEST(BlobRulesConfig, ReadWrittenBackAndChecked)
 {
     DetectorConfig c;
     EXPECT_EQ(c.split.waist_ratio[0], 0.0);   // off unless a config sets it
@@ -55,9 +56,21 @@ TEST(SplitConfig, ReadWrittenBackAndChecked)
         << load("classes:\n  green:\n    split_waist: 1.5\n", bad);
     EXPECT_EQ(load("classes:\n  green:\n    split_wiast: 0.5\n", bad).rfind("FILE:3: classes.green: unknown key 'split_wiast'", 0),
               0u);
+    // the axes: rows by default (not written), both or columns read and written back, others refused
+    EXPECT_EQ(c.split.axes, (unsigned)CYL_SPLIT_ROWS);
+    EXPECT_EQ(y.find("split_axes"), std::string::npos) << y;
+    DetectorConfig both;
+    ASSERT_EQ(load("split_axes: both\nclasses:\n  orange:\n    split_waist: 0.5\n", both), "");
+    EXPECT_EQ(both.split.axes, (unsigned)(CYL_SPLIT_ROWS | CYL_SPLIT_COLUMNS));
+    EXPECT_NE(detector_config_yaml(both, t, "").find("split_axes: both\n"), std::string::npos);
+    DetectorConfig cols;
+    ASSERT_EQ(load("split_axes: columns\n", cols), "");
+    EXPECT_EQ(cols.split.axes, (unsigned)CYL_SPLIT_COLUMNS);
+    EXPECT_EQ(load("roi: [0, 0, 10, 10]\nsplit_axes: diagonal\n", bad),
+              "FILE:2: split_axes: 'diagonal' is not rows, columns or both");
 }
 
-TEST(SplitConfig, DetectorCutsStackedCones)
+TEST(BlobRulesConfig, DetectorCutsStackedCones)
 {
     const uint32_t W = 320, H = 240;
     std::vector<uint8_t> buf(3 * W * H, 128);
@@ -99,4 +112,18 @@ TEST(SplitConfig, DetectorCutsStackedCones)
         EXPECT_GT(obs[0].centroid_v_px, 90.0);
         EXPECT_LT(obs[1].centroid_v_px, 90.0);
     }
+}
+
+TEST(BlobRulesConfig, WeakAloneReadWrittenBackAndChecked)
+{
+    DetectorConfig c;
+    EXPECT_EQ(c.segment.cls[1].weak_alone_min_area, 0u);   // off unless a config sets it
+    ASSERT_EQ(load("classes:\n  green:\n    weak_alone_min_area_px: 1500\n", c), "");
+    EXPECT_EQ(c.segment.cls[1].weak_alone_min_area, 1500u);
+    EXPECT_EQ(c.segment.cls[0].weak_alone_min_area, 0u);
+    const cyl_colortable t = table2();
+    const std::string y = detector_config_yaml(c, t, "test");
+    EXPECT_NE(y.find("  green:\n    weak_alone_min_area_px: 1500\n"), std::string::npos) << y;
+    DetectorConfig bad;
+    EXPECT_EQ(load("classes:\n  green:\n    weak_alone_min_area_px: 2.5\n", bad).rfind("FILE:3: classes.green.weak_alone_min_area_px", 0), 0u);
 }
