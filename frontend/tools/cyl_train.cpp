@@ -605,11 +605,11 @@ int learn_main(int argc, char **argv)
         if (!report.empty()) write_file_atomic(report, learn::report_json(r, t) + "\n");
         if (!config_out.empty()) {
             DetectorConfig cfg;
+            cfg.split.axes = split_axes;
             for (const learn::ClassReport &c : r.classes) {
                 cfg.segment.cls[c.index].merge_gap_px = (int32_t)merge_gap;
                 cfg.gate[c.index].min_fill = min_fill;
                 cfg.split.waist_ratio[c.index] = split_waist;
-                cfg.split.axes = split_axes;
                 cfg.segment.cls[c.index].weak_alone_min_area = (uint32_t)weak_alone;
                 if (c.aspect_max > 0) {
                     cfg.gate[c.index].aspect_min = c.aspect_min / aspect_margin;

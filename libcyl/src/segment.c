@@ -1100,14 +1100,14 @@ static uint32_t cut_cols(cyl_segmentation *seg, cyl_blob *b, uint32_t cut, uint3
         if (r->x < cut && r->x + (uint32_t)(r->width - 1u) * xs >= cut) cross[nc++] = ri;
     }
     if (seg->n_runs + nc > seg->max_runs) return CYL_NONE;
-    /* open a slot after each crossing run: move the runs up from the top, then renumber */
-    for (i = seg->n_runs; i-- > 0;) {
-        const uint32_t to = shifted(cross, nc, i);
-        if (to != i) seg->runs[to] = seg->runs[i];
+    /* open a slot after each crossing run: move the runs above the first one up, from the top,
+     * then renumber (none crosses when every run meeting the cut starts at it) */
+    if (nc) {
+        for (i = seg->n_runs; i-- > cross[0] + 1u;) seg->runs[shifted(cross, nc, i)] = seg->runs[i];
+        seg->n_runs += nc;
+        for (i = 0; i < seg->n_runs; i++) seg->runs[i].next = shifted(cross, nc, seg->runs[i].next);
+        for (k = 0; k < seg->n_blobs; k++) seg->blobs[k].first_run = shifted(cross, nc, seg->blobs[k].first_run);
     }
-    seg->n_runs += nc;
-    for (i = 0; i < seg->n_runs; i++) seg->runs[i].next = shifted(cross, nc, seg->runs[i].next);
-    for (k = 0; k < seg->n_blobs; k++) seg->blobs[k].first_run = shifted(cross, nc, seg->blobs[k].first_run);
     for (k = 0; k < nc; k++) cross[k] += k;   /* their new places (the slot is at +1) */
     /* deal the runs out, in order, to two lists; a crossing run's right piece takes its slot */
     for (ri = b->first_run, k = 0; ri != CYL_NONE;) {

@@ -52,8 +52,8 @@ TEST(BlobRulesConfig, ReadWrittenBackAndChecked)
     ASSERT_EQ(load(y, back), "");
     EXPECT_DOUBLE_EQ(back.split.waist_ratio[0], 0.45);
     DetectorConfig bad;
-    EXPECT_EQ(load("classes:\n  green:\n    split_waist: 1.5\n", bad).rfind("FILE:3: classes.green.split_waist", 0), 0u)
-        << load("classes:\n  green:\n    split_waist: 1.5\n", bad);
+    const std::string range = load("classes:\n  green:\n    split_waist: 1.5\n", bad);
+    EXPECT_EQ(range.rfind("FILE:3: classes.green.split_waist", 0), 0u) << range;
     EXPECT_EQ(load("classes:\n  green:\n    split_wiast: 0.5\n", bad).rfind("FILE:3: classes.green: unknown key 'split_wiast'", 0),
               0u);
     // the axes: rows by default (not written), both or columns read and written back, others refused
