@@ -46,7 +46,9 @@ const char *kUsage =
     "  --overlay DIR       write DIR/STEM.png per image: classified pixels tinted, label boxes white,\n"
     "                      blobs in their class colour, false blobs red (DIR must exist)\n"
     "  --boxes FILE.csv    one row per labelled box: its best IoU, whether it was found, whether a\n"
-    "                      blob's centroid lies in it, and the share of its pixels in the class\n"
+    "                      blob's centroid lies in it, the share of its pixels in the class, and the\n"
+    "                      blob matched to it (box, area, CYL_BLOB_* flags); one row per false blob\n"
+    "                      (matched_iou false_blob, its box and the blob columns)\n"
     "  -q, --quiet         no progress\n"
     "\n"
     "exit codes: 0 ok, 1 failed (unreadable image, label or table), 2 bad command line\n";

@@ -916,6 +916,7 @@ static cyl_status finish(cyl_segmentation *seg, const cyl_image *img, const cyl_
             if (alone == 0 || acc[i].n < (int64_t)alone) continue;
         }
         if (k != i) seg->blobs[k] = seg->blobs[i];
+        if (weak && !acc[i].strong) seg->blobs[k].flags |= CYL_BLOB_WEAK_ONLY;
         finish_blob(seg, &seg->blobs[k], &acc[i]);
         k++;
     }

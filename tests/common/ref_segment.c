@@ -108,6 +108,7 @@ int ref_segment(const cyl_colortable *t, const cyl_image *img, const cyl_segment
             if (rb->x1 == rx + (nx - 1) * xs) rb->touches |= CYL_BLOB_TOUCH_RIGHT;
             if (rb->y0 == ry) rb->touches |= CYL_BLOB_TOUCH_TOP;
             if (rb->y1 == ry + (ny - 1) * ys) rb->touches |= CYL_BLOB_TOUCH_BOTTOM;
+            rb->weak_only = weak && !has_strong;
             if (weak && !has_strong &&   /* weak evidence alone: no blob, unless large enough */
                 (p->cls[rb->cls].weak_alone_min_area == 0 || rb->area < p->cls[rb->cls].weak_alone_min_area))
                 rb->area = 0;

@@ -12,6 +12,7 @@ typedef struct ref_blob {
     double cx, cy, mxx, myy, mxy;
     uint32_t first_x, first_y;   /* first sample in raster order */
     int touches;                  /* CYL_BLOB_TOUCH_* bits */
+    int weak_only;                /* of a class's weak evidence alone (no run of the class itself) */
 } ref_blob;
 
 /* Returns the number of blobs written (<= max_blobs), or -1 on allocation failure.

@@ -70,6 +70,38 @@ assert r["images"] == 10
 EOF
 then ok training_report; else bad training_report "report check failed"; fi
 
+# 3b. the per-box CSV (cyl-score --boxes) of the subset run: a found box names its blob, whose box
+# overlaps the label box at IoU >= 0.5 (recomputed here); a box not found has empty blob columns; a
+# false blob's row repeats its box in the blob columns, with its area >= 20 px
+run boxes_csv
+if msg=$(python3 - "$T/re/frc-boxes.csv" "$T/re/ball-boxes.csv" 2>&1 <<'EOF'
+import csv, sys
+n_found = n_false = 0
+for path in sys.argv[1:]:
+    rows = list(csv.DictReader(open(path)))
+    assert rows and list(rows[0])[-6:] == ["blob_x0_px", "blob_y0_px", "blob_x1_px", "blob_y1_px",
+                                           "blob_area_px", "blob_flags"], list(rows[0])
+    for r in rows:
+        box = [float(r[k]) for k in ("x0_px", "y0_px", "x1_px", "y1_px")]
+        if r["matched_iou"] == "false_blob":
+            blob = [float(r[k]) for k in ("blob_x0_px", "blob_y0_px", "blob_x1_px", "blob_y1_px")]
+            assert blob == box and int(r["blob_area_px"]) >= 20, r
+            n_false += 1
+        elif r["matched_iou"] == "1":
+            b = [float(r[k]) for k in ("blob_x0_px", "blob_y0_px", "blob_x1_px", "blob_y1_px")]
+            ix = min(box[2], b[2]) - max(box[0], b[0])
+            iy = min(box[3], b[3]) - max(box[1], b[1])
+            inter = max(ix, 0) * max(iy, 0)
+            iou = inter / ((box[2] - box[0]) * (box[3] - box[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter)
+            assert 0.5 <= iou <= float(r["best_iou"]) + 5e-3, (r, iou)   # boxes and IoU printed rounded
+            assert 0 < int(r["blob_area_px"]) <= (b[2] - b[0]) * (b[3] - b[1]), r
+            n_found += 1
+        else:
+            assert r["matched_iou"] == "0" and r["blob_area_px"] == "", r
+assert n_found >= 5 and n_false >= 1, (n_found, n_false)
+EOF
+); then ok boxes_csv; else bad boxes_csv "$msg"; fi
+
 # 4. the detector config written by --config-out loads in cyl detect (strict keys) and in cyl-score
 run config_round_trip
 if grep -q "aspect_range" "$T/re/frc-detector.yaml" &&

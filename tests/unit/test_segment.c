@@ -489,6 +489,7 @@ static void test_bruteforce_random(void **state)
             assert_int_equal(b->x0, r->x0); assert_int_equal(b->x1, r->x1);
             assert_int_equal(b->y0, r->y0); assert_int_equal(b->y1, r->y1);
             assert_int_equal(b->flags & CYL_BLOB_TOUCH_ANY, r->touches);
+            assert_int_equal(!!(b->flags & CYL_BLOB_WEAK_ONLY), r->weak_only);
             assert_true(fabs(b->cx_px - r->cx) < 1e-9 && fabs(b->cy_px - r->cy) < 1e-9);
             assert_true(fabs(b->mxx_px2 - r->mxx) < 1e-6 && fabs(b->myy_px2 - r->myy) < 1e-6);
             assert_true(fabs(b->mxy_px2 - r->mxy) < 1e-6);

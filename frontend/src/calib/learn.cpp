@@ -503,9 +503,17 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
     std::vector<uint8_t> split_work;
     uint32_t cap_w = 0, cap_h = 0;
     size_t done = 0;
-    // one row per labelled box; false blobs too, with matched_iou "false_blob" and their area in
-    // centroid_inside's column
-    std::string csv = "image,class,x0_px,y0_px,x1_px,y1_px,best_iou,matched_iou,centroid_inside,class_px_share\n";
+    // one row per labelled box (with the blob matched to it, if any); false blobs too, with matched_iou
+    // "false_blob" and their own box in x0..y1 and in the blob columns
+    std::string csv = "image,class,x0_px,y0_px,x1_px,y1_px,best_iou,matched_iou,centroid_inside,class_px_share,"
+                      "blob_x0_px,blob_y0_px,blob_x1_px,blob_y1_px,blob_area_px,blob_flags\n";
+    // a blob's columns: box as x0, y0, x1 + 1, y1 + 1 (the label boxes' convention), area, CYL_BLOB_* flags
+    auto blob_cols = [](const cyl_blob *K) {
+        if (!K) return std::string(",,,,,");
+        char b[128];
+        std::snprintf(b, sizeof b, "%d,%d,%d,%d,%u,%u", K->x0, K->y0, K->x1 + 1, K->y1 + 1, K->area, (unsigned)K->flags);
+        return std::string(b);
+    };
     std::unique_ptr<Detector> det;
     if (o.camera) det.reset(new Detector(t, *o.camera, o.detector));
     std::vector<char> observed;   // per blob of the detector's segmentation: an observation kept it
@@ -572,9 +580,11 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
                 }
             std::sort(pairs.begin(), pairs.end(), [](const Pair &a, const Pair &b) { return a.iou > b.iou; });
             std::vector<char> box_used(boxes.size(), 0), blob_used(blobs.size(), 0);
+            std::vector<const cyl_blob *> box_blob(boxes.size(), nullptr);
             for (const Pair &p : pairs) {
                 if (box_used[p.b] || blob_used[p.k]) continue;
                 box_used[p.b] = blob_used[p.k] = 1;
+                box_blob[p.b] = blobs[p.k];
             }
             for (size_t bi = 0; bi < boxes.size(); bi++) {
                 const Box &B = *boxes[bi];
@@ -604,10 +614,10 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
                         cin = cin || (K->cx_px + 0.5 >= B.x0 && K->cx_px + 0.5 < B.x1 && K->cy_px + 0.5 >= B.y0 &&
                                       K->cy_px + 0.5 < B.y1);
                     char b[512];
-                    std::snprintf(b, sizeof b, "%s,%s,%.1f,%.1f,%.1f,%.1f,%.3f,%d,%d,%.3f\n", path.c_str(), cs.name.c_str(),
+                    std::snprintf(b, sizeof b, "%s,%s,%.1f,%.1f,%.1f,%.1f,%.3f,%d,%d,%.3f,", path.c_str(), cs.name.c_str(),
                                   B.x0, B.y0, B.x1, B.y1, best, (int)box_used[bi], (int)cin,
                                   all_px ? (double)inside_px / (double)all_px : 0.0);
-                    csv += b;
+                    csv += b + blob_cols(box_blob[bi]) + "\n";
                 }
                 for (const cyl_blob *K : blobs)
                     centroid = centroid || (K->cx_px + 0.5 >= B.x0 && K->cx_px + 0.5 < B.x1 && K->cy_px + 0.5 >= B.y0 &&
@@ -628,9 +638,9 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
                 cs.false_blobs += !inside;
                 if (!inside && !o.boxes_csv.empty()) {
                     char b[512];
-                    std::snprintf(b, sizeof b, "%s,%s,%d,%d,%d,%d,,false_blob,%u,\n", path.c_str(), cs.name.c_str(),
-                                  K->x0, K->y0, K->x1 + 1, K->y1 + 1, K->area);
-                    csv += b;
+                    std::snprintf(b, sizeof b, "%s,%s,%d,%d,%d,%d,,false_blob,,,", path.c_str(), cs.name.c_str(),
+                                  K->x0, K->y0, K->x1 + 1, K->y1 + 1);
+                    csv += b + blob_cols(K) + "\n";
                 }
                 if (!vis.empty()) {
                     const uint8_t *rgb = t.rgb[k];

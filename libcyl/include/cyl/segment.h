@@ -59,6 +59,8 @@ typedef struct cyl_run {
 #define CYL_BLOB_TOUCH_ANY    0x0Fu
 #define CYL_BLOB_MERGED       0x10u  /* made of more than one 4-connected component */
 #define CYL_BLOB_SPLIT        0x20u  /* one part of a blob cut at a waist (cyl_segment_split) */
+#define CYL_BLOB_WEAK_ONLY    0x40u  /* made of weak evidence alone, kept by weak_alone_min_area
+                                        (its parts after a split keep the flag) */
 
 /* One blob: 4-connected runs of one class, possibly merged with nearby ones. */
 typedef struct cyl_blob {
