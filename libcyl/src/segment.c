@@ -484,16 +484,24 @@ static void uf_union(cyl_run *r, uint32_t a, uint32_t b)
 static void connect_rows(cyl_run *r, uint32_t pb, uint32_t pe, uint32_t cb, uint32_t ce, uint32_t xs,
                          const uint8_t *eq)
 {
-    uint32_t i = pb, j = cb;
-    while (i < pe && j < ce) {
-        uint32_t a0 = r[i].x, a1 = a0 + (uint32_t)(r[i].width - 1u) * xs;
-        uint32_t b0 = r[j].x, b1 = b0 + (uint32_t)(r[j].width - 1u) * xs;
+    uint32_t i = pb, j = cb, a0, a1, b0, b1;
+    if (i >= pe || j >= ce) return;
+    /* each run's first and last column, recomputed only for the run the walk moves to */
+    a0 = r[i].x; a1 = a0 + (uint32_t)(r[i].width - 1u) * xs;
+    b0 = r[j].x; b1 = b0 + (uint32_t)(r[j].width - 1u) * xs;
+    for (;;) {
         if (a0 <= b1 && b0 <= a1 && eq[r[i].cls] == eq[r[j].cls]) {
             /* a run not yet joined is its own root: it joins i's root (smaller, as i < j) */
             if (r[j].blob == j) r[j].blob = uf_find(r, i);
             else uf_union(r, i, j);
         }
-        if (a1 < b1) i++; else j++;
+        if (a1 < b1) {
+            if (++i >= pe) return;
+            a0 = r[i].x; a1 = a0 + (uint32_t)(r[i].width - 1u) * xs;
+        } else {
+            if (++j >= ce) return;
+            b0 = r[j].x; b1 = b0 + (uint32_t)(r[j].width - 1u) * xs;
+        }
     }
 }
 
@@ -862,16 +870,19 @@ static cyl_status finish(cyl_segmentation *seg, const cyl_image *img, const cyl_
     seg->min_run_px = p->min_run_px;
     for (k = 0; k < CYL_MAX_CLASSES; k++) seg->merge_gap_px[k] = p->cls[k].merge_gap_px;
 
-    /* 2. labels: flatten, then number the roots in raster order. A root's
-     *    label is parked in its `next` field until every run is labelled. */
-    for (i = 0; i < n_runs; i++) runs[i].blob = runs[runs[i].blob].blob;
+    /* 2. labels, in one pass: each run's root (a parent's index is never larger than its run's,
+     *    and every earlier run already points at its root, so one step reaches it), and the roots
+     *    numbered in raster order. A run's label is parked in its `next` field (a root's first,
+     *    read by the runs after it) until step 3 moves it to `blob`. */
     for (i = 0; i < n_runs; i++) {
-        uint32_t root = runs[i].blob;
+        const uint32_t root = runs[runs[i].blob].blob;
+        runs[i].blob = root;
         if (root == i) {
             if (nb < seg->max_blobs) runs[i].next = nb++;
             else { runs[i].next = CYL_NONE; seg->truncated |= CYL_SEG_BLOBS_FULL; }
+        } else {
+            runs[i].next = runs[root].next;
         }
-        runs[i].blob = runs[root].next;
     }
 
     /* 3. accumulate statistics and run lists */
@@ -882,8 +893,9 @@ static cyl_status finish(cyl_segmentation *seg, const cyl_image *img, const cyl_
     }
     for (i = 0; i < n_runs; i++) {
         cyl_run *rn = &runs[i];
-        uint32_t bi = rn->blob, xe;
+        uint32_t bi = rn->next, xe;
         cyl_blob *b;
+        rn->blob = bi;
         rn->next = CYL_NONE;
         if (bi == CYL_NONE) continue;
         b = &seg->blobs[bi];
