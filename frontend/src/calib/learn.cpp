@@ -564,19 +564,23 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
             std::vector<const Box *> boxes;
             for (const Box &b : l.boxes)
                 if (b.label == cs.label) boxes.push_back(&b);
+            // a blob's box (its last column and row included) against a label box; its centroid in one
+            auto iou = [](const Box &B, const cyl_blob &K) {
+                const double kx0 = K.x0, kx1 = K.x1 + 1.0, ky0 = K.y0, ky1 = K.y1 + 1.0;
+                const double ix = std::min(B.x1, kx1) - std::max(B.x0, kx0), iy = std::min(B.y1, ky1) - std::max(B.y0, ky0);
+                if (ix <= 0 || iy <= 0) return 0.0;
+                return ix * iy / (B.width() * B.height() + (kx1 - kx0) * (ky1 - ky0) - ix * iy);
+            };
+            auto centroid_in = [](const Box &B, const cyl_blob &K) {
+                return K.cx_px + 0.5 >= B.x0 && K.cx_px + 0.5 < B.x1 && K.cy_px + 0.5 >= B.y0 && K.cy_px + 0.5 < B.y1;
+            };
             // IoU matching, greedy by IoU, one blob per box
             struct Pair { double iou; size_t b, k; };
             std::vector<Pair> pairs;
             for (size_t bi = 0; bi < boxes.size(); bi++)
                 for (size_t kb = 0; kb < blobs.size(); kb++) {
-                    const Box &B = *boxes[bi];
-                    const cyl_blob &K = *blobs[kb];
-                    double kx0 = K.x0, kx1 = K.x1 + 1.0, ky0 = K.y0, ky1 = K.y1 + 1.0;
-                    double ix = std::min(B.x1, kx1) - std::max(B.x0, kx0), iy = std::min(B.y1, ky1) - std::max(B.y0, ky0);
-                    if (ix <= 0 || iy <= 0) continue;
-                    double inter = ix * iy, uni = B.width() * B.height() + (kx1 - kx0) * (ky1 - ky0) - inter;
-                    double iou = inter / uni;
-                    if (iou >= o.iou) pairs.push_back({iou, bi, kb});
+                    const double v = iou(*boxes[bi], *blobs[kb]);
+                    if (v > 0 && v >= o.iou) pairs.push_back({v, bi, kb});
                 }
             std::sort(pairs.begin(), pairs.end(), [](const Pair &a, const Pair &b) { return a.iou > b.iou; });
             std::vector<char> box_used(boxes.size(), 0), blob_used(blobs.size(), 0);
@@ -590,15 +594,13 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
                 const Box &B = *boxes[bi];
                 const bool large = B.width() >= o.min_box_px;
                 bool centroid = false;
+                double best = 0;
+                for (const cyl_blob *K : blobs) {
+                    centroid = centroid || centroid_in(B, *K);
+                    best = std::max(best, iou(B, *K));
+                }
                 if (!o.boxes_csv.empty()) {
-                    double best = 0;
                     uint64_t inside_px = 0, all_px = 0;
-                    for (const cyl_blob *K : blobs) {
-                        double kx0 = K->x0, kx1 = K->x1 + 1.0, ky0 = K->y0, ky1 = K->y1 + 1.0;
-                        double ix = std::min(B.x1, kx1) - std::max(B.x0, kx0), iy = std::min(B.y1, ky1) - std::max(B.y0, ky0);
-                        if (ix > 0 && iy > 0)
-                            best = std::max(best, ix * iy / (B.width() * B.height() + (kx1 - kx0) * (ky1 - ky0) - ix * iy));
-                    }
                     int x0, x1, y0, y1;
                     px_range(B.x0, B.x1, (int)img.width, &x0, &x1);
                     px_range(B.y0, B.y1, (int)img.height, &y0, &y1);
@@ -609,19 +611,12 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
                             inside_px += cyl_mask_class(cyl_colortable_mask(&t, Y, U, V)) == k;
                             all_px++;
                         }
-                    bool cin = false;
-                    for (const cyl_blob *K : blobs)
-                        cin = cin || (K->cx_px + 0.5 >= B.x0 && K->cx_px + 0.5 < B.x1 && K->cy_px + 0.5 >= B.y0 &&
-                                      K->cy_px + 0.5 < B.y1);
                     char b[512];
                     std::snprintf(b, sizeof b, "%s,%s,%.1f,%.1f,%.1f,%.1f,%.3f,%d,%d,%.3f,", path.c_str(), cs.name.c_str(),
-                                  B.x0, B.y0, B.x1, B.y1, best, (int)box_used[bi], (int)cin,
+                                  B.x0, B.y0, B.x1, B.y1, best, (int)box_used[bi], (int)centroid,
                                   all_px ? (double)inside_px / (double)all_px : 0.0);
                     csv += b + blob_cols(box_blob[bi]) + "\n";
                 }
-                for (const cyl_blob *K : blobs)
-                    centroid = centroid || (K->cx_px + 0.5 >= B.x0 && K->cx_px + 0.5 < B.x1 && K->cy_px + 0.5 >= B.y0 &&
-                                            K->cy_px + 0.5 < B.y1);
                 cs.boxes++;
                 cs.boxes_large += large;
                 cs.found_iou += box_used[bi];
@@ -632,9 +627,7 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
             for (const cyl_blob *K : blobs) {
                 if (K->area < o.fp_min_area) continue;
                 bool inside = false;
-                for (const Box *B : boxes)
-                    inside = inside || (K->cx_px + 0.5 >= B->x0 && K->cx_px + 0.5 < B->x1 && K->cy_px + 0.5 >= B->y0 &&
-                                        K->cy_px + 0.5 < B->y1);
+                for (const Box *B : boxes) inside = inside || centroid_in(*B, *K);
                 cs.false_blobs += !inside;
                 if (!inside && !o.boxes_csv.empty()) {
                     char b[512];
