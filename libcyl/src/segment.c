@@ -174,19 +174,20 @@ typedef struct bg_skip {
 
 /* Background pairs from sample x (even offset from the row's pairs) on: returns the first x' >= x
  * such that every pair in [x, x') has uv == 0 (and x' + 1 < x1 where a pair may be coloured).
- * Short gaps are walked by the scalar test (4 pairs); longer ones by the vector skip on the coarse
+ * Short gaps between runs are walked by the scalar test (4 pairs; with probe 0, at a row's start,
+ * the vector skip starts at once); longer ones by the vector skip on the coarse
  * chroma map, then the scalar test again for at most 8 pairs, since a block bit may be set by
  * another chroma of the block. Where the background's chroma keeps falling in blocks the map
  * cannot rule out, the vector skip costs more than it saves: after two short skips it is off for
  * the rest of the row and the next 7 rows. */
 CYL_HOT_INLINE uint32_t skip_background(const cyl_colortable *t, const uint8_t *up, const uint8_t *vp,
-                                        const unsigned cs, uint32_t x, uint32_t x1, bg_skip *sk)
+                                        const unsigned cs, uint32_t x, uint32_t x1, bg_skip *sk, int probe)
 {
     const cyl_mask (*uv)[256] = t->uv;
     const uint8_t *pu = up + (x / 2u) * cs, *pv = vp + (x / 2u) * cs;
     uint32_t xlim = x1;
     if (sk->fn) {
-        const uint32_t xw = x + 8u < x1 ? x + 8u : x1;
+        const uint32_t xw = !probe ? x : x + 8u < x1 ? x + 8u : x1;
         while (x + 1u < xw && uv[pu[0]][pv[0]] == 0) { x += 2u; pu += cs; pv += cs; }
         if (x + 1u < xw) return x;   /* a pair that may be coloured */
         if (x + 1u < x1) {
@@ -254,7 +255,7 @@ CYL_HOT_INLINE int encode_pairs(rle_ctx *ctx, const cyl_colortable *t, uint32_t 
              * reading luma (skip_background). */
             const uint8_t *pu = up + (x / 2u) * cs, *pv = vp + (x / 2u) * cs;
             if (uv[pu[0]][pv[0]] == 0) {
-                x = skip_background(t, up, vp, cs, x + 2u, x1, &sk);
+                x = skip_background(t, up, vp, cs, x + 2u, x1, &sk, x > x0 + 1u);
                 continue;
             }
             m = uv[pu[0]][pv[0]];
@@ -383,7 +384,7 @@ CYL_HOT_INLINE void classify_pairs(const cyl_colortable *t, const uint8_t *yp, c
         const uint8_t U = up[(x / 2u) * cs], V = vp[(x / 2u) * cs];
         const cyl_mask m = t->uv[U][V];
         if (m == 0) {
-            const uint32_t xn = skip_background(t, up, vp, cs, x + 2u, x1, sk);
+            const uint32_t xn = skip_background(t, up, vp, cs, x + 2u, x1, sk, 1);
             memset(o + (x - x0), CYL_CLASS_NONE, xn - x);
             x = xn;
             prev = CYL_CLASS_NONE;

@@ -23,6 +23,9 @@
  * (block bit set) among the whole blocks of 16 pairs it examined; when fewer than 16
  * pairs are left it stops and returns the first pair it did not examine. It reads only
  * the chroma bytes of pairs [p, q] rounded up to its block: no byte past pair n - 1.
+ * The AVX2 skip examines a range of at least 32 pairs to its end (its last block is the
+ * range's last 32 pairs, reading up to 31 pairs before p, which are not reported) and
+ * returns n when no pair is a candidate.
  *
  * Inside a run the vector path tests whole blocks of pairs against the run's class's inner box
  * (cyl_colortable.inner_lo / inner_hi, computed by cyl_colortable_refresh(): colours that are
@@ -168,9 +171,11 @@ CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_skip_bits256(__m256i h)
     return ~(unsigned)_mm256_movemask_epi8(_mm256_cmpeq_epi8(h, _mm256_setzero_si256()));
 }
 
-#define CYL_SKIP_PACKED_AVX2(NAME, UO, FINE)                                                   \
-    CYL_SKIP_TARGET_AVX2 static uint32_t NAME(const uint8_t *u, const uint8_t *v,              \
-                                              const uint8_t (*map)[16], uint32_t p, uint32_t n) \
+/* The coarse candidates among the 32 pairs from pair p: bit i set when pair p + i's block bit is
+ * set, in pair order. */
+#define CYL_COARSE_PACKED_AVX2(NAME, UO)                                                       \
+    CYL_SKIP_TARGET_AVX2 static inline unsigned NAME(const uint8_t *u, const uint8_t *v,       \
+                                                     const uint8_t (*map)[16], uint32_t p)     \
     {                                                                                          \
         const __m256i nib = _mm256_set1_epi8(0xF);                                             \
         const __m256i sh = _mm256_setr_epi8(UO, UO + 4, UO + 8, UO + 12, UO + 2, UO + 6, UO + 10, \
@@ -179,69 +184,79 @@ CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_skip_bits256(__m256i h)
                                             UO + 14, -1, -1, -1, -1, -1, -1, -1, -1);          \
         /* the dwords hold pairs 0-3, 8-11, 16-19, 24-27 | 4-7, 12-15, 20-23, 28-31 */          \
         const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);                      \
-        for (; p + 32u <= n; p += 32u) {                                                       \
-            const uint8_t *b = u + 4u * (size_t)p;                                             \
-            __m256i w0 = _mm256_shuffle_epi8(_mm256_loadu_si256((const __m256i *)(const void *)b), sh);        \
-            __m256i w1 = _mm256_shuffle_epi8(_mm256_loadu_si256((const __m256i *)(const void *)(b + 32)), sh); \
-            __m256i w2 = _mm256_shuffle_epi8(_mm256_loadu_si256((const __m256i *)(const void *)(b + 64)), sh); \
-            __m256i w3 = _mm256_shuffle_epi8(_mm256_loadu_si256((const __m256i *)(const void *)(b + 96)), sh); \
-            __m256i a = _mm256_unpacklo_epi32(w0, w1), c = _mm256_unpacklo_epi32(w2, w3);      \
-            __m256i un = _mm256_and_si256(_mm256_srli_epi16(_mm256_unpacklo_epi64(a, c), 4), nib); \
-            __m256i vn = _mm256_and_si256(_mm256_srli_epi16(_mm256_unpackhi_epi64(a, c), 4), nib); \
-            __m256i h = cyl_skip_hits256(un, vn, map);                                         \
-            if (!_mm256_testz_si256(h, h)) {                                                   \
-                const unsigned m = cyl_skip_bits256(_mm256_permutevar8x32_epi32(h, order));     \
-                _mm256_zeroupper();                                                            \
-                return p + (uint32_t)__builtin_ctz(m);                                         \
-            }                                                                                  \
-        }                                                                                      \
-        _mm256_zeroupper();                                                                    \
-        return FINE(u, v, map, p, n);                                                          \
+        const uint8_t *b = u + 4u * (size_t)p;                                                 \
+        __m256i w0 = _mm256_shuffle_epi8(_mm256_loadu_si256((const __m256i *)(const void *)b), sh);        \
+        __m256i w1 = _mm256_shuffle_epi8(_mm256_loadu_si256((const __m256i *)(const void *)(b + 32)), sh); \
+        __m256i w2 = _mm256_shuffle_epi8(_mm256_loadu_si256((const __m256i *)(const void *)(b + 64)), sh); \
+        __m256i w3 = _mm256_shuffle_epi8(_mm256_loadu_si256((const __m256i *)(const void *)(b + 96)), sh); \
+        __m256i a = _mm256_unpacklo_epi32(w0, w1), c = _mm256_unpacklo_epi32(w2, w3);          \
+        __m256i un = _mm256_and_si256(_mm256_srli_epi16(_mm256_unpacklo_epi64(a, c), 4), nib); \
+        __m256i vn = _mm256_and_si256(_mm256_srli_epi16(_mm256_unpackhi_epi64(a, c), 4), nib); \
+        __m256i h = cyl_skip_hits256(un, vn, map);                                             \
+        (void)v;                                                                               \
+        if (_mm256_testz_si256(h, h)) return 0u;                                               \
+        return cyl_skip_bits256(_mm256_permutevar8x32_epi32(h, order));                        \
     }
-CYL_SKIP_PACKED_AVX2(cyl_skip_yuyv_avx2, 1, cyl_skip_yuyv_ssse3)
-CYL_SKIP_PACKED_AVX2(cyl_skip_uyvy_avx2, 0, cyl_skip_uyvy_ssse3)
-#undef CYL_SKIP_PACKED_AVX2
+CYL_COARSE_PACKED_AVX2(cyl_coarse_yuyv_avx2, 1)
+CYL_COARSE_PACKED_AVX2(cyl_coarse_uyvy_avx2, 0)
+#undef CYL_COARSE_PACKED_AVX2
 
-CYL_SKIP_TARGET_AVX2 static uint32_t cyl_skip_nv12_avx2(const uint8_t *u, const uint8_t *v,
-                                                        const uint8_t (*map)[16], uint32_t p, uint32_t n)
+CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_coarse_nv12_avx2(const uint8_t *u, const uint8_t *v,
+                                                                 const uint8_t (*map)[16], uint32_t p)
 {
     const __m256i nib = _mm256_set1_epi16(0xF);
-    for (; p + 32u <= n; p += 32u) {
-        const uint8_t *b = u + 2u * (size_t)p;
-        __m256i w0 = _mm256_loadu_si256((const __m256i *)(const void *)b);
-        __m256i w1 = _mm256_loadu_si256((const __m256i *)(const void *)(b + 32));
-        __m256i un = _mm256_packus_epi16(_mm256_and_si256(_mm256_srli_epi16(w0, 4), nib),
-                                         _mm256_and_si256(_mm256_srli_epi16(w1, 4), nib));
-        __m256i vn = _mm256_packus_epi16(_mm256_srli_epi16(w0, 12), _mm256_srli_epi16(w1, 12));
-        __m256i h = cyl_skip_hits256(un, vn, map);
-        if (!_mm256_testz_si256(h, h)) {
-            /* the in-lane packs leave the qwords holding pairs 0-7, 16-23 | 8-15, 24-31 */
-            const unsigned m = cyl_skip_bits256(_mm256_permute4x64_epi64(h, 0xD8));
-            _mm256_zeroupper();
-            return p + (uint32_t)__builtin_ctz(m);
-        }
-    }
-    _mm256_zeroupper();   /* the SSSE3 code is not VEX-encoded: no transition penalty */
-    return cyl_skip_nv12_ssse3(u, v, map, p, n);
+    const uint8_t *b = u + 2u * (size_t)p;
+    __m256i w0 = _mm256_loadu_si256((const __m256i *)(const void *)b);
+    __m256i w1 = _mm256_loadu_si256((const __m256i *)(const void *)(b + 32));
+    __m256i un = _mm256_packus_epi16(_mm256_and_si256(_mm256_srli_epi16(w0, 4), nib),
+                                     _mm256_and_si256(_mm256_srli_epi16(w1, 4), nib));
+    __m256i vn = _mm256_packus_epi16(_mm256_srli_epi16(w0, 12), _mm256_srli_epi16(w1, 12));
+    __m256i h = cyl_skip_hits256(un, vn, map);
+    (void)v;
+    if (_mm256_testz_si256(h, h)) return 0u;
+    /* the in-lane packs leave the qwords holding pairs 0-7, 16-23 | 8-15, 24-31 */
+    return cyl_skip_bits256(_mm256_permute4x64_epi64(h, 0xD8));
 }
 
-CYL_SKIP_TARGET_AVX2 static uint32_t cyl_skip_i420_avx2(const uint8_t *u, const uint8_t *v,
-                                                        const uint8_t (*map)[16], uint32_t p, uint32_t n)
+CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_coarse_i420_avx2(const uint8_t *u, const uint8_t *v,
+                                                                 const uint8_t (*map)[16], uint32_t p)
 {
     const __m256i nib = _mm256_set1_epi8(0xF);
-    for (; p + 32u <= n; p += 32u) {
-        __m256i un = _mm256_and_si256(_mm256_srli_epi16(_mm256_loadu_si256((const __m256i *)(const void *)(u + p)), 4), nib);
-        __m256i vn = _mm256_and_si256(_mm256_srli_epi16(_mm256_loadu_si256((const __m256i *)(const void *)(v + p)), 4), nib);
-        __m256i h = cyl_skip_hits256(un, vn, map);
-        if (!_mm256_testz_si256(h, h)) {
-            const unsigned m = cyl_skip_bits256(h);   /* planar: already in pair order */
-            _mm256_zeroupper();
-            return p + (uint32_t)__builtin_ctz(m);
-        }
-    }
-    _mm256_zeroupper();
-    return cyl_skip_i420_ssse3(u, v, map, p, n);
+    __m256i un = _mm256_and_si256(_mm256_srli_epi16(_mm256_loadu_si256((const __m256i *)(const void *)(u + p)), 4), nib);
+    __m256i vn = _mm256_and_si256(_mm256_srli_epi16(_mm256_loadu_si256((const __m256i *)(const void *)(v + p)), 4), nib);
+    __m256i h = cyl_skip_hits256(un, vn, map);
+    if (_mm256_testz_si256(h, h)) return 0u;
+    return cyl_skip_bits256(h);   /* planar: already in pair order */
 }
+
+/* The AVX2 skip: 32 pairs at a time; the last pairs of a range of at least 32 are examined as the
+ * range's last 32 (the bits of the pairs before p masked off: they were examined, or lie before the
+ * range, and are read but not reported), so the whole range is examined and n comes back when no
+ * pair of it is a candidate. A range of fewer than 32 pairs goes to the SSSE3 code (FINE). */
+#define CYL_SKIP_AVX2(NAME, COARSE, FINE)                                                      \
+    CYL_SKIP_TARGET_AVX2 static uint32_t NAME(const uint8_t *u, const uint8_t *v,              \
+                                              const uint8_t (*map)[16], uint32_t p, uint32_t n) \
+    {                                                                                          \
+        unsigned m;                                                                            \
+        if (p + 32u > n) return FINE(u, v, map, p, n);                                         \
+        for (; p + 32u <= n; p += 32u) {                                                       \
+            m = COARSE(u, v, map, p);                                                          \
+            if (m) { _mm256_zeroupper(); return p + (uint32_t)__builtin_ctz(m); }              \
+        }                                                                                      \
+        if (p < n) {                                                                           \
+            const uint32_t q = n - 32u;                                                        \
+            m = COARSE(u, v, map, q) & (0xFFFFFFFFu << (p - q));                               \
+            _mm256_zeroupper();                                                                \
+            return m ? q + (uint32_t)__builtin_ctz(m) : n;                                     \
+        }                                                                                      \
+        _mm256_zeroupper();                                                                    \
+        return n;                                                                              \
+    }
+CYL_SKIP_AVX2(cyl_skip_yuyv_avx2, cyl_coarse_yuyv_avx2, cyl_skip_yuyv_ssse3)
+CYL_SKIP_AVX2(cyl_skip_uyvy_avx2, cyl_coarse_uyvy_avx2, cyl_skip_uyvy_ssse3)
+CYL_SKIP_AVX2(cyl_skip_nv12_avx2, cyl_coarse_nv12_avx2, cyl_skip_nv12_ssse3)
+CYL_SKIP_AVX2(cyl_skip_i420_avx2, cyl_coarse_i420_avx2, cyl_skip_i420_ssse3)
+#undef CYL_SKIP_AVX2
 
 /* A packed pair's 4 box bytes (corner c: Y, U, V) with Y0, Y1, U, V at byte offsets oy0, oy1, ou, ov. */
 static inline uint32_t cyl_box_word(const uint8_t *c, unsigned oy0, unsigned oy1, unsigned ou, unsigned ov)
