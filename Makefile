@@ -137,7 +137,7 @@ $(BUILD)/bench_segment: bench/bench_segment.cpp bench/bench_frames.hpp $(BENCH_C
 	  $$(pkg-config --cflags --libs opencv4) -lm
 
 # Each part prints its table; the last line merges every part's JSON fragment.
-bench: $(BUILD)/bench_segment $(BUILD)/bench_uncertainty $(BUILD)/bench_replay $(BUILD)/cyl $(BUILD)/cyl-train $(BUILD)/cyl-score $(STAMP)/debs-bench
+bench: $(BUILD)/bench_segment $(BUILD)/bench_uncertainty $(BUILD)/bench_replay $(BUILD)/cyl $(BUILD)/cyl-render $(BUILD)/cyl-train $(BUILD)/cyl-score $(STAMP)/debs-bench
 	@BUILD=$(BUILD) SHARED=$(SHARED) scripts/bench.sh
 
 clean:

@@ -45,7 +45,7 @@ calib-tools: $(BUILD)/cyl-calibrate $(BUILD)/cyl-train $(BUILD)/cyl-score
 # make realeval: the full benchmark on the real image sets outside the repository (SHARED, default
 # ../shared); make test runs its small committed form (tests/fixtures/real).
 SHARED ?= ../shared
-realeval: $(BUILD)/cyl-train $(BUILD)/cyl-score
+realeval: $(BUILD)/cyl $(BUILD)/cyl-render $(BUILD)/cyl-train $(BUILD)/cyl-score
 	@python3 scripts/realeval.py --shared $(SHARED) --build $(BUILD)
 .PHONY: realeval
 TEST_EXTRA += $(BUILD)/cyl-score $(BUILD)/cyl-train $(BUILD)/cyl
