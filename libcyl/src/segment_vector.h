@@ -152,14 +152,12 @@ CYL_SKIP_TARGET static uint32_t cyl_skip_i420_ssse3(const uint8_t *u, const uint
 #endif
 
 /* The candidate bytes among 32 (0xFF where the block bit is set), in the order the lanes hold them. */
-CYL_SKIP_TARGET_AVX2 static inline __m256i cyl_skip_hits256(__m256i un, __m256i vn, const uint8_t (*map)[16])
+CYL_SKIP_TARGET_AVX2 static inline __m256i cyl_skip_hits256(__m256i un, __m256i vn, __m256i lo, __m256i hi)
 {
     const __m256i bitlo = _mm256_setr_epi8(1, 2, 4, 8, 16, 32, 64, (char)128, 0, 0, 0, 0, 0, 0, 0, 0,
                                            1, 2, 4, 8, 16, 32, 64, (char)128, 0, 0, 0, 0, 0, 0, 0, 0);
     const __m256i bithi = _mm256_setr_epi8(0, 0, 0, 0, 0, 0, 0, 0, 1, 2, 4, 8, 16, 32, 64, (char)128,
                                            0, 0, 0, 0, 0, 0, 0, 0, 1, 2, 4, 8, 16, 32, 64, (char)128);
-    const __m256i lo = _mm256_broadcastsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)map[0]));
-    const __m256i hi = _mm256_broadcastsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)map[1]));
     __m256i a = _mm256_and_si256(_mm256_shuffle_epi8(lo, vn), _mm256_shuffle_epi8(bitlo, un));
     __m256i b = _mm256_and_si256(_mm256_shuffle_epi8(hi, vn), _mm256_shuffle_epi8(bithi, un));
     return _mm256_or_si256(a, b);
@@ -171,19 +169,17 @@ CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_skip_bits256(__m256i h)
     return ~(unsigned)_mm256_movemask_epi8(_mm256_cmpeq_epi8(h, _mm256_setzero_si256()));
 }
 
-/* The coarse candidates among the 32 pairs from pair p: bit i set when pair p + i's block bit is
- * set, in pair order. */
-#define CYL_COARSE_PACKED_AVX2(NAME, UO)                                                       \
-    CYL_SKIP_TARGET_AVX2 static inline unsigned NAME(const uint8_t *u, const uint8_t *v,       \
-                                                     const uint8_t (*map)[16], uint32_t p)     \
+/* The coarse map's hit bytes of the 32 pairs from pair p (non-zero where the pair's block bit is
+ * set), in the order the lanes hold them; lo, hi: the map's two halves in both lanes. */
+#define CYL_HITS_PACKED_AVX2(NAME, UO)                                                         \
+    CYL_SKIP_TARGET_AVX2 static inline __m256i NAME(const uint8_t *u, const uint8_t *v,        \
+                                                    __m256i lo, __m256i hi, uint32_t p)        \
     {                                                                                          \
         const __m256i nib = _mm256_set1_epi8(0xF);                                             \
         const __m256i sh = _mm256_setr_epi8(UO, UO + 4, UO + 8, UO + 12, UO + 2, UO + 6, UO + 10, \
                                             UO + 14, -1, -1, -1, -1, -1, -1, -1, -1,           \
                                             UO, UO + 4, UO + 8, UO + 12, UO + 2, UO + 6, UO + 10, \
                                             UO + 14, -1, -1, -1, -1, -1, -1, -1, -1);          \
-        /* the dwords hold pairs 0-3, 8-11, 16-19, 24-27 | 4-7, 12-15, 20-23, 28-31 */          \
-        const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);                      \
         const uint8_t *b = u + 4u * (size_t)p;                                                 \
         __m256i w0 = _mm256_shuffle_epi8(_mm256_loadu_si256((const __m256i *)(const void *)b), sh);        \
         __m256i w1 = _mm256_shuffle_epi8(_mm256_loadu_si256((const __m256i *)(const void *)(b + 32)), sh); \
@@ -192,17 +188,15 @@ CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_skip_bits256(__m256i h)
         __m256i a = _mm256_unpacklo_epi32(w0, w1), c = _mm256_unpacklo_epi32(w2, w3);          \
         __m256i un = _mm256_and_si256(_mm256_srli_epi16(_mm256_unpacklo_epi64(a, c), 4), nib); \
         __m256i vn = _mm256_and_si256(_mm256_srli_epi16(_mm256_unpackhi_epi64(a, c), 4), nib); \
-        __m256i h = cyl_skip_hits256(un, vn, map);                                             \
         (void)v;                                                                               \
-        if (_mm256_testz_si256(h, h)) return 0u;                                               \
-        return cyl_skip_bits256(_mm256_permutevar8x32_epi32(h, order));                        \
+        return cyl_skip_hits256(un, vn, lo, hi);                                               \
     }
-CYL_COARSE_PACKED_AVX2(cyl_coarse_yuyv_avx2, 1)
-CYL_COARSE_PACKED_AVX2(cyl_coarse_uyvy_avx2, 0)
-#undef CYL_COARSE_PACKED_AVX2
+CYL_HITS_PACKED_AVX2(cyl_hits_yuyv_avx2, 1)
+CYL_HITS_PACKED_AVX2(cyl_hits_uyvy_avx2, 0)
+#undef CYL_HITS_PACKED_AVX2
 
-CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_coarse_nv12_avx2(const uint8_t *u, const uint8_t *v,
-                                                                 const uint8_t (*map)[16], uint32_t p)
+CYL_SKIP_TARGET_AVX2 static inline __m256i cyl_hits_nv12_avx2(const uint8_t *u, const uint8_t *v,
+                                                              __m256i lo, __m256i hi, uint32_t p)
 {
     const __m256i nib = _mm256_set1_epi16(0xF);
     const uint8_t *b = u + 2u * (size_t)p;
@@ -211,51 +205,67 @@ CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_coarse_nv12_avx2(const uint8_t *
     __m256i un = _mm256_packus_epi16(_mm256_and_si256(_mm256_srli_epi16(w0, 4), nib),
                                      _mm256_and_si256(_mm256_srli_epi16(w1, 4), nib));
     __m256i vn = _mm256_packus_epi16(_mm256_srli_epi16(w0, 12), _mm256_srli_epi16(w1, 12));
-    __m256i h = cyl_skip_hits256(un, vn, map);
     (void)v;
-    if (_mm256_testz_si256(h, h)) return 0u;
-    /* the in-lane packs leave the qwords holding pairs 0-7, 16-23 | 8-15, 24-31 */
-    return cyl_skip_bits256(_mm256_permute4x64_epi64(h, 0xD8));
+    return cyl_skip_hits256(un, vn, lo, hi);
 }
 
-CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_coarse_i420_avx2(const uint8_t *u, const uint8_t *v,
-                                                                 const uint8_t (*map)[16], uint32_t p)
+CYL_SKIP_TARGET_AVX2 static inline __m256i cyl_hits_i420_avx2(const uint8_t *u, const uint8_t *v,
+                                                              __m256i lo, __m256i hi, uint32_t p)
 {
     const __m256i nib = _mm256_set1_epi8(0xF);
     __m256i un = _mm256_and_si256(_mm256_srli_epi16(_mm256_loadu_si256((const __m256i *)(const void *)(u + p)), 4), nib);
     __m256i vn = _mm256_and_si256(_mm256_srli_epi16(_mm256_loadu_si256((const __m256i *)(const void *)(v + p)), 4), nib);
-    __m256i h = cyl_skip_hits256(un, vn, map);
-    if (_mm256_testz_si256(h, h)) return 0u;
-    return cyl_skip_bits256(h);   /* planar: already in pair order */
+    return cyl_skip_hits256(un, vn, lo, hi);
 }
 
-/* The AVX2 skip: 32 pairs at a time; the last pairs of a range of at least 32 are examined as the
- * range's last 32 (the bits of the pairs before p masked off: they were examined, or lie before the
- * range, and are read but not reported), so the whole range is examined and n comes back when no
- * pair of it is a candidate. A range of fewer than 32 pairs goes to the SSSE3 code (FINE). */
-#define CYL_SKIP_AVX2(NAME, COARSE, FINE)                                                      \
+/* A block's hit bytes put back in pair order, one bit a pair. Packed: the dwords hold pairs 0-3,
+ * 8-11, 16-19, 24-27 | 4-7, 12-15, 20-23, 28-31; NV12: the in-lane packs leave the qwords holding
+ * pairs 0-7, 16-23 | 8-15, 24-31; I420: already in pair order. */
+CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_bits_packed_avx2(__m256i h)
+{
+    return cyl_skip_bits256(_mm256_permutevar8x32_epi32(h, _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7)));
+}
+CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_bits_nv12_avx2(__m256i h)
+{
+    return cyl_skip_bits256(_mm256_permute4x64_epi64(h, 0xD8));
+}
+CYL_SKIP_TARGET_AVX2 static inline unsigned cyl_bits_i420_avx2(__m256i h) { return cyl_skip_bits256(h); }
+
+/* The AVX2 skip: 32 pairs at a time (the map's halves loaded once); the last pairs of a range of
+ * at least 32 are examined as the range's last 32 (the bits of the pairs before p masked off: they
+ * were examined, or lie before the range, and are read but not reported), so the whole range is
+ * examined and n comes back when no pair of it is a candidate. A range of fewer than 32 pairs goes
+ * to the SSSE3 code (FINE). */
+#define CYL_SKIP_AVX2(NAME, HITS, BITS, FINE)                                                  \
     CYL_SKIP_TARGET_AVX2 static uint32_t NAME(const uint8_t *u, const uint8_t *v,              \
                                               const uint8_t (*map)[16], uint32_t p, uint32_t n) \
     {                                                                                          \
+        __m256i lo, hi, h0;                                                                    \
         unsigned m;                                                                            \
         if (p + 32u > n) return FINE(u, v, map, p, n);                                         \
+        lo = _mm256_broadcastsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)map[0])); \
+        hi = _mm256_broadcastsi128_si256(_mm_loadu_si128((const __m128i *)(const void *)map[1])); \
         for (; p + 32u <= n; p += 32u) {                                                       \
-            m = COARSE(u, v, map, p);                                                          \
-            if (m) { _mm256_zeroupper(); return p + (uint32_t)__builtin_ctz(m); }              \
+            h0 = HITS(u, v, lo, hi, p);                                                        \
+            if (!_mm256_testz_si256(h0, h0)) {                                                 \
+                m = BITS(h0);                                                                  \
+                _mm256_zeroupper();                                                            \
+                return p + (uint32_t)__builtin_ctz(m);                                         \
+            }                                                                                  \
         }                                                                                      \
         if (p < n) {                                                                           \
             const uint32_t q = n - 32u;                                                        \
-            m = COARSE(u, v, map, q) & (0xFFFFFFFFu << (p - q));                               \
+            m = BITS(HITS(u, v, lo, hi, q)) & (0xFFFFFFFFu << (p - q));                        \
             _mm256_zeroupper();                                                                \
             return m ? q + (uint32_t)__builtin_ctz(m) : n;                                     \
         }                                                                                      \
         _mm256_zeroupper();                                                                    \
         return n;                                                                              \
     }
-CYL_SKIP_AVX2(cyl_skip_yuyv_avx2, cyl_coarse_yuyv_avx2, cyl_skip_yuyv_ssse3)
-CYL_SKIP_AVX2(cyl_skip_uyvy_avx2, cyl_coarse_uyvy_avx2, cyl_skip_uyvy_ssse3)
-CYL_SKIP_AVX2(cyl_skip_nv12_avx2, cyl_coarse_nv12_avx2, cyl_skip_nv12_ssse3)
-CYL_SKIP_AVX2(cyl_skip_i420_avx2, cyl_coarse_i420_avx2, cyl_skip_i420_ssse3)
+CYL_SKIP_AVX2(cyl_skip_yuyv_avx2, cyl_hits_yuyv_avx2, cyl_bits_packed_avx2, cyl_skip_yuyv_ssse3)
+CYL_SKIP_AVX2(cyl_skip_uyvy_avx2, cyl_hits_uyvy_avx2, cyl_bits_packed_avx2, cyl_skip_uyvy_ssse3)
+CYL_SKIP_AVX2(cyl_skip_nv12_avx2, cyl_hits_nv12_avx2, cyl_bits_nv12_avx2, cyl_skip_nv12_ssse3)
+CYL_SKIP_AVX2(cyl_skip_i420_avx2, cyl_hits_i420_avx2, cyl_bits_i420_avx2, cyl_skip_i420_ssse3)
 #undef CYL_SKIP_AVX2
 
 /* A packed pair's 4 box bytes (corner c: Y, U, V) with Y0, Y1, U, V at byte offsets oy0, oy1, ou, ov. */
