@@ -143,8 +143,8 @@ CYL_SKIP_TARGET static uint32_t cyl_skip_i420_ssse3(const uint8_t *u, const uint
 
 /* AVX2: 32 pairs at a time. The in-lane shuffles and packs leave the pairs permuted (U and V
  * alike), which is enough to tell that a block has no candidate; in a block that has one, a
- * cross-lane permutation puts the hits back in pair order and the first is the answer. Less than
- * 32 pairs left go to the SSSE3 code. */
+ * cross-lane permutation puts the hits back in pair order and the first is the answer. A range of
+ * fewer than 32 pairs goes to the SSSE3 code (see CYL_SKIP_AVX2). */
 #if defined(__AVX2__)
 #define CYL_SKIP_TARGET_AVX2
 #else

@@ -594,12 +594,10 @@ ScoreResult score(const cyl_colortable &t, const std::vector<std::string> &image
                 const Box &B = *boxes[bi];
                 const bool large = B.width() >= o.min_box_px;
                 bool centroid = false;
-                double best = 0;
-                for (const cyl_blob *K : blobs) {
-                    centroid = centroid || centroid_in(B, *K);
-                    best = std::max(best, iou(B, *K));
-                }
+                for (const cyl_blob *K : blobs) centroid = centroid || centroid_in(B, *K);
                 if (!o.boxes_csv.empty()) {
+                    double best = 0;
+                    for (const cyl_blob *K : blobs) best = std::max(best, iou(B, *K));
                     uint64_t inside_px = 0, all_px = 0;
                     int x0, x1, y0, y1;
                     px_range(B.x0, B.x1, (int)img.width, &x0, &x1);
