@@ -117,6 +117,11 @@ def learn_and_score(build, out, name, train, test, classes, learn_extra=(), cali
     for c in rep["classes"]:
         print(f"   training report {c['name']}: recall {100 * c['recall']:.1f}% of labelled px, background claimed "
               f"{100 * c['background_claimed']:.3f}%, largest frame share {100 * c['max_frame_share']:.2f}%")
+        wa = c.get("weak_alone")
+        if wa:
+            print(f"   weak blobs alone {'on from ' + str(wa['min_area_px']) + ' px' if wa['min_area_px'] else 'off'} "
+                  f"(training images: boxes found {wa['train_boxes_found_off']} -> {wa['train_boxes_found_on']}, "
+                  f"false blobs {wa['train_fp_per_image_off']:.2f} -> {wa['train_fp_per_image_on']:.2f} per image)")
         for w in c["warnings"]:
             print(f"   warning: {w}")
     text, res = score(build, table, config, classes, sl, calib, os.path.join(out, name + "-boxes.csv"))

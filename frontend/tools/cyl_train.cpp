@@ -77,9 +77,11 @@ const char *kUsage =
     "                      other; default 0.5; 0: off)\n"
     "  --split-axes A      (for --config-out) cut between rows (default), columns (side by side)\n"
     "                      or both\n"
-    "  --weak-alone-area N (for --config-out) a blob of weak pixels alone (no pixel of the class\n"
-    "                      itself: a landmark in shade) counts when it has at least N px\n"
-    "                      (default 0: never)\n"
+    "  --weak-alone-area N|auto  (for --config-out) a blob of weak pixels alone (no pixel of the\n"
+    "                      class itself: a landmark in shade) counts when it has at least N px\n"
+    "                      (0: never). auto (default): per class, 700 px when on the training\n"
+    "                      images it finds more of the class's boxes than without and adds no more\n"
+    "                      than 1 false blob per image, else 0 (the report says which and why)\n"
     "  --size NAME=D,H     (for --config-out, repeatable) the class's landmark diameter and height,\n"
     "                      m: the config gets size_m and the expected-size gate at the measured range\n"
     "  --size-gate F       that gate's factor for classes given a size (default 2; 0: off)\n"
@@ -485,7 +487,7 @@ int learn_main(int argc, char **argv)
     std::string out, base, report, config_out;
     double aspect_margin = 2.0, min_fill = 0.3, size_gate = 2.0, split_waist = 0.5;
     unsigned split_axes = cyl_split_params_default().axes;
-    long weak_alone = 0;
+    long weak_alone = -1;   // -1: auto (chosen per class on the training images)
     bool weak_fpr_given = false;
     std::vector<std::pair<std::string, cyl_landmark_size>> sizes;
     long merge_gap = 3;
@@ -508,7 +510,13 @@ int learn_main(int argc, char **argv)
             else if (s == "--aspect-margin") aspect_margin = parse_num(s, next(), 1, 100, false);
             else if (s == "--min-fill") min_fill = parse_num(s, next(), 0, 1, false);
             else if (s == "--split-waist") split_waist = parse_num(s, next(), 0, 1, false);
-            else if (s == "--weak-alone-area") weak_alone = (long)parse_num(s, next(), 0, 1e9, true);
+            else if (s == "--weak-alone-area") {
+                const std::string v = next();
+                if (v == "auto") weak_alone = -1;
+                else if (v.empty() || v.find_first_not_of("0123456789") != std::string::npos)
+                    throw Usage("--weak-alone-area: expected a whole number of px or auto, got '" + v + "'");
+                else weak_alone = (long)parse_num(s, v, 0, 1e9, true);
+            }
             else if (s == "--split-axes") {
                 const std::string v = next();
                 split_axes = split_axes_from_name(v);
@@ -602,7 +610,6 @@ int learn_main(int argc, char **argv)
         });
         bar.done();
         save_table(out, t);
-        if (!report.empty()) write_file_atomic(report, learn::report_json(r, t) + "\n");
         if (!config_out.empty()) {
             DetectorConfig cfg;
             cfg.split.axes = split_axes;
@@ -610,7 +617,7 @@ int learn_main(int argc, char **argv)
                 cfg.segment.cls[c.index].merge_gap_px = (int32_t)merge_gap;
                 cfg.gate[c.index].min_fill = min_fill;
                 cfg.split.waist_ratio[c.index] = split_waist;
-                cfg.segment.cls[c.index].weak_alone_min_area = (uint32_t)weak_alone;
+                cfg.segment.cls[c.index].weak_alone_min_area = weak_alone > 0 ? (uint32_t)weak_alone : 0;
                 if (c.aspect_max > 0) {
                     cfg.gate[c.index].aspect_min = c.aspect_min / aspect_margin;
                     cfg.gate[c.index].aspect_max = c.aspect_max * aspect_margin;
@@ -622,9 +629,13 @@ int learn_main(int argc, char **argv)
                 cfg.observe.size[k] = sz.second;
                 cfg.gate[k].size_gate = size_gate;
             }
+            if (weak_alone < 0)
+                learn::choose_weak_alone(t, images, classes, learn::kWeakAloneAreaPx, learn::kWeakAloneMaxFalsePerImage,
+                                         cfg, r);
             write_file_atomic(config_out, detector_config_yaml(cfg, t, "cyl detector config written by cyl-train learn "
                                                                        "(blob shape gates from the labelled boxes)"));
         }
+        if (!report.empty()) write_file_atomic(report, learn::report_json(r, t) + "\n");
         if (!quiet) {
             std::fputs(learn::report_text(r, t).c_str(), stdout);
         std::fflush(stdout);

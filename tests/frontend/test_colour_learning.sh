@@ -32,10 +32,11 @@ if python3 scripts/realeval.py --subset $R --build "$B" --out "$T/re" >"$T/re.lo
   msg=$(python3 - "$T/re.json" <<'EOF'
 import json, sys
 r = json.load(open(sys.argv[1]))
-# measured on this subset: ball centroid 0.25 (8 balls), cone 0.81, cube 0.67, hard scene 0.99
-# (0.44 before the surround was taken out of the classes), false blobs at most 0.5 per image and
-# 0 per rendered frame
-floors = {"ball_recall_centroid": 0.2, "cone_recall_iou50": 0.7, "cube_recall_iou50": 0.55, "hard_synth_recall": 0.9}
+# measured on this subset: ball centroid 0.25 (8 balls), cone 0.86, cube 0.92 (0.67 with weak
+# blobs alone off: the training images turn them on for the cube alone), hard scene 0.99 (0.44
+# before the surround was taken out of the classes), false blobs at most 0.56 per image and 0 per
+# rendered frame
+floors = {"ball_recall_centroid": 0.2, "cone_recall_iou50": 0.7, "cube_recall_iou50": 0.8, "hard_synth_recall": 0.9}
 out = [f"{k} {r[k]:.3f} < {v}" for k, v in floors.items() if r[k] < v]
 if r["fp_per_image_max"] > 1.0:
     out.append(f"fp_per_image_max {r['fp_per_image_max']:.2f} > 1")
@@ -66,6 +67,12 @@ for c in r["classes"]:
     assert c["weak_index"] is not None
     assert 0 < c["recall"] <= 1 and 0 <= c["background_claimed"] <= 0.01, c
     assert c["box_aspect_range"][0] > 0, c
+    # weak blobs alone, chosen on the training images: on exactly when they find more boxes there
+    # and keep the false blobs within 1 per image (on this subset: the cube only, 7 -> 8 of 9)
+    w = c["weak_alone"]
+    gain = w["train_boxes_found_on"] > w["train_boxes_found_off"] and w["train_fp_per_image_on"] <= 1.0
+    assert w["tried_area_px"] == 700 and w["min_area_px"] == (700 if gain else 0), c
+assert [c["weak_alone"]["min_area_px"] for c in r["classes"]] == [0, 700], r
 assert r["images"] == 10
 EOF
 then ok training_report; else bad training_report "report check failed"; fi

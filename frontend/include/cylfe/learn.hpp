@@ -86,6 +86,15 @@ struct ClassReport {
     double worst_frame_share = 0.0;       // largest share of a training frame the class covers
     std::string worst_frame;
     std::vector<std::string> warnings;
+    // Weak blobs alone (choose_weak_alone): what the class's training images said. Not evaluated
+    // when no detector config was written.
+    struct WeakAlone {
+        bool evaluated = false;
+        uint32_t area_px = 0;             // weak_alone_min_area chosen for the config (0: off)
+        uint32_t tried_area_px = 0;       // the area tried
+        uint64_t found_off = 0, found_on = 0;   // training boxes found at IoU >= 0.5 without / with it
+        double fp_off = 0.0, fp_on = 0.0;       // false blobs per training image without / with it
+    } weak_alone;
 };
 
 struct LearnResult {
@@ -108,6 +117,17 @@ LearnResult learn_from_labels(cyl_colortable &t, const std::vector<std::string> 
 // The same from frames in memory (cyl-train --gui).
 LearnResult learn_from_frames(cyl_colortable &t, const std::vector<LabelledFrame> &frames,
                               const std::vector<ClassSpec> &classes, const LearnOptions &o);
+
+// Weak blobs alone, per class, from the training images (docs/colour-learning.md). Each class of
+// r is scored (score() below, cfg's camera-free gates) on the images it was learned from, with
+// cfg's weak_alone_min_area 0 and area_px: it keeps area_px when that finds more of its boxes at
+// IoU >= 0.5 and its false blobs stay at most max_fp_per_image, else 0. Writes the choice into
+// cfg.segment.cls[index].weak_alone_min_area and the figures into r.classes[].weak_alone.
+constexpr uint32_t kWeakAloneAreaPx = 700;           // chosen on the tuning data (docs/colour-learning.md)
+constexpr double kWeakAloneMaxFalsePerImage = 1.0;   // the real-image benchmark's false-blob limit
+void choose_weak_alone(const cyl_colortable &t, const std::vector<std::string> &images,
+                       const std::vector<ClassSpec> &classes, uint32_t area_px, double max_fp_per_image,
+                       DetectorConfig &cfg, LearnResult &r);
 
 // Human-readable report (several lines) and one JSON object.
 std::string report_text(const LearnResult &r, const cyl_colortable &t);

@@ -443,9 +443,46 @@ std::string report_text(const LearnResult &r, const cyl_colortable &t)
         }
         s += "\n";
     }
+    for (const ClassReport &c : r.classes) {
+        const ClassReport::WeakAlone &w = c.weak_alone;
+        if (!w.evaluated) continue;
+        std::snprintf(b, sizeof b,
+                      "%s: weak blobs alone (from %u px) %s: on its training images they find %llu -> %llu boxes, "
+                      "false blobs %.2f -> %.2f per image\n",
+                      c.name.c_str(), w.tried_area_px, w.area_px ? "on" : "off", (unsigned long long)w.found_off,
+                      (unsigned long long)w.found_on, w.fp_off, w.fp_on);
+        s += b;
+    }
     for (const ClassReport &c : r.classes)
         for (const std::string &w : c.warnings) s += "warning: " + c.name + ": " + w + "\n";
     return s;
+}
+
+void choose_weak_alone(const cyl_colortable &t, const std::vector<std::string> &images,
+                       const std::vector<ClassSpec> &classes, uint32_t area_px, double max_fp_per_image,
+                       DetectorConfig &cfg, LearnResult &r)
+{
+    ScoreOptions so;
+    so.detector = cfg;
+    for (const ClassReport &c : r.classes) so.detector.segment.cls[c.index].weak_alone_min_area = 0;
+    const ScoreResult off = score(t, images, classes, so);
+    for (const ClassReport &c : r.classes) so.detector.segment.cls[c.index].weak_alone_min_area = area_px;
+    const ScoreResult on = score(t, images, classes, so);
+    const double n = off.images ? (double)off.images : 1.0;
+    for (ClassReport &c : r.classes) {
+        for (size_t k = 0; k < classes.size(); k++) {
+            if (classes[k].name != c.name) continue;
+            ClassReport::WeakAlone &w = c.weak_alone;
+            w.evaluated = true;
+            w.tried_area_px = area_px;
+            w.found_off = off.classes[k].found_iou;
+            w.found_on = on.classes[k].found_iou;
+            w.fp_off = (double)off.classes[k].false_blobs / n;
+            w.fp_on = (double)on.classes[k].false_blobs / n;
+            w.area_px = (area_px > 0 && w.found_on > w.found_off && w.fp_on <= max_fp_per_image) ? area_px : 0;
+            cfg.segment.cls[c.index].weak_alone_min_area = w.area_px;
+        }
+    }
 }
 
 std::string report_json(const LearnResult &r, const cyl_colortable &t)
@@ -465,7 +502,16 @@ std::string report_json(const LearnResult &r, const cyl_colortable &t)
              num(c.r.weak_bg_fraction, 6) + ", \"weak_ratio_threshold\": " + num(c.r.weak_lr_threshold, 6) + ", \"weak_cells\": " +
              std::to_string(c.r.weak_cells) +
              ", \"max_frame_share\": " + num(c.worst_frame_share, 6) + ", \"box_aspect_range\": [" + num(c.aspect_min, 6) +
-             ", " + num(c.aspect_max, 6) + "], \"lost_to\": {";
+             ", " + num(c.aspect_max, 6) + "], \"weak_alone\": ";
+        const ClassReport::WeakAlone &w = c.weak_alone;
+        if (w.evaluated)
+            s += "{\"min_area_px\": " + std::to_string(w.area_px) + ", \"tried_area_px\": " + std::to_string(w.tried_area_px) +
+                 ", \"train_boxes_found_off\": " + std::to_string(w.found_off) + ", \"train_boxes_found_on\": " +
+                 std::to_string(w.found_on) + ", \"train_fp_per_image_off\": " + num(w.fp_off, 6) +
+                 ", \"train_fp_per_image_on\": " + num(w.fp_on, 6) + "}";
+        else
+            s += "null";
+        s += ", \"lost_to\": {";
         bool first = true;
         for (unsigned j = 0; j < CYL_MAX_CLASSES; j++)
             if (c.r.lost_to[j] > 0) {
