@@ -207,6 +207,107 @@ def calib_prior(cov):
     return gtsam.PriorFactorVector(CALIB, np.zeros(8), gtsam.noiseModel.Gaussian.Covariance(c))
 
 
+def Z(i):
+    """Step i's time-correlated odometry error, unit variance per component (x, y, theta): a
+    Vector3 (Step.odom_gm)."""
+    return gtsam.symbol("z", i)
+
+
+def odom_factors(s, k_prev, k, z_prev, z, prev_has_state, scale=1.0, state=True):
+    """The factors of step s's odometry from pose key k_prev to pose key k, and the new variables
+    they need as (key, initial value) pairs.
+
+    Without s.odom_gm (or with state False): one BetweenFactorPose2 with s.odom_cov (times scale^2).
+    With it, the step's error is e = w + sum_j sd_j * z_j (per component x, y, theta): w white with
+    covariance s.odom_gm[0], each z_j a unit-variance Gauss-Markov state shared in time (one per
+    exponential of the fitted correlation), z_k = phi z_{k-1} + sqrt(1 - phi^2) n (its first value a
+    N(0, 1) prior); sd and phi list the terms one after the other (3 values each). The factor on
+    (x_{k-1}, x_k, z_k) has GTSAM's BetweenFactor residual Logmap(odom^-1 x_{k-1}^-1 x_k) minus
+    sum_j sd_j * z_j: neighbouring steps' errors then point the same way, as they do on a real robot, where
+    s.odom_cov only inflates each step's variance by its correlation sum. `scale` multiplies both
+    parts (the gating pass's sigma scale).
+
+    The state factors are Python (gtsam.CustomFactor): optimise graphs holding them with
+    `batch_optimize(..., python_loop=True)`, never with iSAM2 or GTSAM's own optimisers, which hand
+    every factor call a copy of all the values (pybind), O(n) a call."""
+    inc = gtsam.Pose2(*s.odom)
+    if s.odom_gm is None or not state:
+        cov = np.asarray(s.odom_cov, float) * scale * scale
+        return [gtsam.BetweenFactorPose2(k_prev, k, inc, gtsam.noiseModel.Gaussian.Covariance(cov))], []
+    cov = np.asarray(s.odom_gm[0], float) * scale * scale
+    sd = np.asarray(s.odom_gm[1], float) * scale
+    phi = np.asarray(s.odom_gm[2], float)
+    m = len(sd) // 3                            # Gauss-Markov terms: z = (z_1 (x, y, theta), z_2, ...)
+    hz = -np.hstack([np.diag(sd[3 * j:3 * j + 3]) for j in range(m)])
+
+    def error(this, values, H):
+        h1 = np.zeros((3, 3), order="F")
+        h2 = np.zeros((3, 3), order="F")
+        hl = np.zeros((3, 3), order="F")
+        t = values.atPose2(k_prev).between(values.atPose2(k), h1, h2)
+        e = gtsam.Pose2.Logmap(inc.between(t), hl) + hz @ values.atVector(z)
+        if H is not None:
+            H[0] = hl @ h1
+            H[1] = hl @ h2
+            H[2] = hz
+        return e
+
+    out = [gtsam.CustomFactor(gtsam.noiseModel.Gaussian.Covariance(cov), [k_prev, k, z], error)]
+    if prev_has_state:
+        hp = -np.diag(phi)
+
+        def chain(this, values, H):
+            if H is not None:
+                H[0] = hp
+                H[1] = np.eye(3 * m)
+            return values.atVector(z) - phi * values.atVector(z_prev)
+        out.append(gtsam.CustomFactor(
+            gtsam.noiseModel.Diagonal.Variances(np.maximum(1.0 - phi * phi, 1e-12)), [z_prev, z], chain))
+    else:
+        out.append(gtsam.PriorFactorVector(z, np.zeros(3 * m), gtsam.noiseModel.Unit.Create(3 * m)))
+    return out, [(z, np.zeros(3 * m))]
+
+
+def batch_optimize(graph, values, max_iter=100, python_loop=False):
+    """Levenberg-Marquardt: (estimate, iterations). GTSAM's optimiser, or with python_loop (graphs
+    with odometry states, `odom_factors`) the same iteration written here -- linearise, damp every
+    variable by lambda I, solve, retract; lambda / 10 on a step that lowers the error, x 10
+    otherwise; stop when the error falls by less than 1e-5 (relative or absolute) -- so that the
+    values stay Python's own and the Python factors read them without a copy."""
+    if not python_loop:
+        lp = gtsam.LevenbergMarquardtParams()
+        lp.setMaxIterations(max_iter)
+        opt = gtsam.LevenbergMarquardtOptimizer(graph, values, lp)
+        return opt.optimize(), opt.iterations()
+    v = gtsam.Values(values)
+    keys = list(v.keys())
+    dims = [_dim(v, key) for key in keys]
+    err = graph.error(v)
+    lam = 1e-5
+    it = 0
+    while it < max_iter:
+        it += 1
+        gfg = graph.linearize(v)
+        while True:
+            damped = gfg.clone()
+            for key, d in zip(keys, dims):
+                damped.add(gtsam.JacobianFactor(key, math.sqrt(lam) * np.eye(d), np.zeros(d),
+                                                gtsam.noiseModel.Unit.Create(d)))
+            nv = v.retract(damped.optimize())
+            nerr = graph.error(nv)
+            if nerr <= err:
+                break
+            lam *= 10.0
+            if lam > 1e10:
+                return v, it
+        done = err - nerr < 1e-5 or (err - nerr) < 1e-5 * err
+        v, err = nv, nerr
+        lam = max(lam / 10.0, 1e-10)
+        if done:
+            break
+    return v, it
+
+
 BIG = 1e9      # an assignment cost that stands for "not allowed" (Hungarian cost matrices)
 
 
@@ -415,6 +516,14 @@ class Slam:
         graph.add(f)
         new_f.add(f)
         base_f = [f]
+        # the odometry's correlated error as states (odom_factors) where the steps carry them: in
+        # the batch graph, but never in iSAM2 (online, each step's inflated variance), and with
+        # unknown association and re-association only in the last solve, the pairings made with
+        # the inflated model (each re-association pass re-solves the whole graph)
+        with_states = any(st_.odom_gm is not None for st_ in steps)
+        states_in_batch = with_states and not (mode == "unknown" and p.reassoc)
+        base_states = [f]                   # the prior and the odometry with states (the last solve)
+        z_init = []                         # the odometry states' (key, initial value)
         frames = []
         new_v.insert(X(0), gtsam.Pose2(*start))
         use_calib = p.calib_states and p.fixed_cov is None
@@ -514,13 +623,21 @@ class Slam:
             if i > 0:
                 if s.odom is None:
                     raise ValueError(f"step {i} has no odometry")
-                f = gtsam.BetweenFactorPose2(X(i - 1), X(i), gtsam.Pose2(*s.odom), self._odom_noise(s.odom_cov))
-                base_f.append(f)
-                if scale != 1.0:             # this pass's gating only: the re-association's graph has f
-                    f = gtsam.BetweenFactorPose2(X(i - 1), X(i), gtsam.Pose2(*s.odom),
-                                                 self._odom_noise(np.asarray(s.odom_cov) * scale * scale))
-                graph.add(f)
-                new_f.add(f)
+                # the batch graph has the odometry's correlated error as states where the step
+                # carries them (odom_factors); iSAM2, online, each step's inflated variance
+                gm_prev = steps[i - 1].odom_gm is not None
+                fs, vs = odom_factors(s, X(i - 1), X(i), Z(i - 1), Z(i), gm_prev)
+                base_states.extend(fs)
+                z_init.extend(vs)
+                if not states_in_batch:
+                    fs, _ = odom_factors(s, X(i - 1), X(i), Z(i - 1), Z(i), gm_prev, state=False)
+                base_f.extend(fs)
+                if scale != 1.0:             # this pass's gating only: the re-association's graph has fs
+                    fs, _ = odom_factors(s, X(i - 1), X(i), Z(i - 1), Z(i), gm_prev, scale, state=states_in_batch)
+                for f in fs:
+                    graph.add(f)
+                for f in odom_factors(s, X(i - 1), X(i), Z(i - 1), Z(i), gm_prev, scale, state=False)[0]:
+                    new_f.add(f)
                 cur = compose(cur, s.odom)
                 new_v.insert(X(i), gtsam.Pose2(*cur))
             usable = []
@@ -611,19 +728,24 @@ class Slam:
         st["merged_landmarks"] = len(merged_into)
         st["dropped_unconfirmed"] += pending.expire(n + p.init_window)
         isam_poses = _poses(est, n)
+        if states_in_batch:
+            for key, v in z_init:
+                est.insert(key, v)
+        st["odometry_states"] = len(z_init) if with_states else 0
         if p.batch:
-            lp = gtsam.LevenbergMarquardtParams()
-            lp.setMaxIterations(100)
-            opt = gtsam.LevenbergMarquardtOptimizer(graph, est, lp)
-            est = opt.optimize()
-            st["batch_iterations"] = opt.iterations()
+            est, st["batch_iterations"] = batch_optimize(graph, est, python_loop=states_in_batch)
         removed = set()
         if p.reassoc and mode == "unknown":
             graph, est, assoc, removed = self._reassociate(frames, base_f, est, graph, assoc, lm_class,
                                                            merged_into, gate, st, rebuild=scale != 1.0)
             n_frames_obs = sum(len(u) for _, u, _ in frames)
-            st["assoc_cost"] = (graph.error(est) + (n_frames_obs - len(assoc)) * gate / 2
+            st["assoc_error"] = graph.error(est)     # of the graph the pairings were made with
+            st["assoc_cost"] = (st["assoc_error"] + (n_frames_obs - len(assoc)) * gate / 2
                                 + len({j for (_, _, j) in assoc}) * math.log(max(len(assoc), 2)))
+            if with_states:                  # the last solve, on the pairings made
+                cov_of = {id(o): c for (_, u, cs) in frames for o, c in zip(u, cs)}
+                graph, est = self._solve_pairings(base_states, est, [(i, o, cov_of[id(o)], j) for (i, o, j) in assoc],
+                                                  z_init)
         st["odom_sigma_scale"] = scale
         t_batch = time.perf_counter() - t0 - t_isam
         poses = _poses(est, n)
@@ -659,10 +781,11 @@ class Slam:
                       lm_cov=lm_cov, lm_class=lm_class, lm_ids=lm_ids, assoc=assoc, stats=st,
                       info=info, lm_keys=lm_keys)
 
-    def _solve_pairings(self, base_f, est, pairs):
+    def _solve_pairings(self, base_f, est, pairs, extra=()):
         """The graph of `base_f` and one range-bearing factor per (step, observation, covariance,
-        landmark) of `pairs`, solved by Levenberg-Marquardt from `est` (poses, and the landmarks
-        the pairs name): (graph, estimate)."""
+        landmark) of `pairs`, solved by Levenberg-Marquardt from `est` (poses, odometry states, and
+        the landmarks the pairs name; `extra`: (key, value) pairs for variables `est` lacks):
+        (graph, estimate)."""
         graph = gtsam.NonlinearFactorGraph()
         for f in base_f:
             graph.add(f)
@@ -675,11 +798,14 @@ class Slam:
             sym = gtsam.Symbol(key)
             if sym.chr() == ord("x"):
                 v.insert(key, est.atPose2(key))
+            elif sym.chr() == ord("z"):
+                v.insert(key, est.atVector(key))
             elif sym.index() in used:
                 v.insert(key, est.atPoint2(key))
-        lp = gtsam.LevenbergMarquardtParams()
-        lp.setMaxIterations(100)
-        return graph, gtsam.LevenbergMarquardtOptimizer(graph, v, lp).optimize()
+        for key, val in extra:
+            if not v.exists(key):
+                v.insert(key, val)
+        return graph, batch_optimize(graph, v, python_loop=any(chr(gtsam.Symbol(k).chr()) == "z" for k in v.keys()))[0]
 
     def _reassociate(self, frames, base_f, est, graph, assoc, lm_class, merged_into, gate, st, rebuild=False):
         """Batch re-association (`reassoc` passes at most): every usable observation of every frame
@@ -1019,6 +1145,14 @@ class Information:
         J = sp.csc_matrix((v[keep], (i[keep], j[keep])), shape=(int(i.max()) + 1, c))
         self.H = (J.T @ J).tocsc()
         self.n = c
+        # an elimination order for the Schur complements in `nees`: each pose next to its odometry
+        # state, step by step (a chain: banded), the other variables (landmarks, calibration) last
+        self.rank = np.empty(c)
+        for k in keys:
+            sym = gtsam.Symbol(k)
+            ch = chr(sym.chr())
+            r = 2.0 * sym.index() + (ch == "z") if ch in "xz" else 1e18 + self.cols[k][0]
+            self.rank[self.cols[k]] = r + np.arange(len(self.cols[k])) * 1e-3
 
     def columns(self, keys):
         return np.concatenate([self.cols[k] for k in keys]) if keys else np.zeros(0, int)
@@ -1033,10 +1167,14 @@ class Information:
         e = np.asarray(err, float)
         v = float(e @ (self.H[s][:, s] @ e))
         if len(o):
+            o = o[np.argsort(self.rank[o], kind="stable")]
             Hos = self.H[o][:, s]
             w = Hos @ e
             Hoo = sp.csc_matrix(self.H[o][:, o])
-            v -= float(w @ spl.splu(Hoo).solve(w))
+            # symmetric positive definite: no pivoting, the order above (a general fill-reducing
+            # order took minutes on five robots' 13,000 poses with their odometry states)
+            lu = spl.splu(Hoo, permc_spec="NATURAL", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+            v -= float(w @ lu.solve(w))
         return v
 
 

@@ -531,7 +531,7 @@ def cmd_mrclam(args):
     for rb in robots:
         try:
             ds = read_mrclam(args.dir, rb, duration=args.duration, noise=args.noise,
-                             odom_scale=args.odom_scale, model=model)
+                             odom_scale=args.odom_scale, model=model, odom_corr=args.odom_corr)
         except MrclamError as e:
             print(f"cylslam: error: {e}", file=sys.stderr)
             return EXIT_INPUT
@@ -586,7 +586,8 @@ def cmd_mrclam(args):
                          "robust_k": args.huber_k if args.robust != "none" else None,
                          "odom_scale": args.odom_scale, "gate": args.gate, "new_gate": args.new_gate,
                          "exclusion": args.exclusion, "assoc_method": args.assoc_method,
-                         "reassoc": args.reassoc, "starts": list(args.starts or (1.0,))}
+                         "reassoc": args.reassoc, "starts": list(args.starts or (1.0,)),
+                         "odom_corr": args.odom_corr if model else None}
     if args.multi:
         agg.update(multi_robot(args, datasets, robots))
         if args.check_rmse is not None:
@@ -689,11 +690,15 @@ def cmd_mrclam_noise(args):
     for c in ("x", "y", "theta"):
         o = model.odom[c]
         print(f"| {c} | {o['k_t']:.3g} | {o['k_d']:.3g} | {o['k_a']:.3g} |")
-    for what, corr in (("measurement errors, per robot and landmark", model.corr),
-                       ("odometry step errors, per robot", model.odom_corr)):
+    for what, use, corr in (("measurement errors, per robot and landmark",
+                             "each variance is multiplied by the sum of its correlations", model.corr),
+                            ("odometry step errors, per robot",
+                             "the batch carries them as Gauss-Markov states", model.odom_corr),
+                            ("odometry step errors, one exponential",
+                             "online (iSAM2) each step's variance is multiplied by the sum of its correlations",
+                             model.odom_corr_inflation)):
         if corr:
-            print(f"correlation in time of the {what} (rho(dt) = a1 exp(-dt/tau1) + a2 exp(-dt/tau2); "
-                  "each variance is multiplied by the sum of its correlations):")
+            print(f"correlation in time of the {what} (rho(dt) = a1 exp(-dt/tau1) + a2 exp(-dt/tau2); {use}):")
             for comp, c in corr.items():
                 print(f"  {comp}: a1 {c['a1']:.3f} tau1 {c['tau1_s']:.3g} s, a2 {c['a2']:.3f} tau2 {c['tau2_s']:.3g} s")
     own = nm.check(model, rep["datasets"])
@@ -820,6 +825,11 @@ def build_parser():
                          "on Dataset 7 and shipped with cylslam, cylslam/models/mrclam_noise.json)")
     sp.add_argument("--odom-scale", type=float, default=1.0,
                     help="multiply the odometry sigmas by this (default %(default)s)")
+    sp.add_argument("--odom-corr", choices=["state", "inflate"], default="state",
+                    help="with --noise learned, how the model's odometry correlation in time is used: state "
+                         "(the batch solution carries each step's correlated error as a Gauss-Markov state "
+                         "shared by neighbouring steps) or inflate (each step's variance multiplied by its "
+                         "correlation sum, as iSAM2 uses it online) (default %(default)s)")
     sp.add_argument("--multi", action="store_true",
                     help="also map all the robots together: one graph, shared landmarks, the start poses "
                          "of all robots but the first unknown (known association)")

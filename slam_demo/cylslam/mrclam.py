@@ -19,7 +19,10 @@ RobotN_Measurement.dat (t, barcode, range, bearing), RobotN_Groundtruth.dat (t, 
 
 With a learned noise model (`model`, noise_model.py) the commands are first shifted by its command
 delay and scaled by its speed and turn scales; its sigmas then replace the models below, each
-measurement's and step's variance multiplied by its stream's correlation sum.
+measurement's and step's variance multiplied by its stream's correlation sum. With
+`odom_corr="state"` (the default) each step also carries its error split into a white part and the
+Gauss-Markov states of the odometry's correlation (Step.odom_gm), which the batch solution uses in
+place of the inflated step covariance (backend.odom_factors).
 
 Noise models (documented in README):
 - odometry increment of distance d and rotation a (both of the commanded motion) over dt s:
@@ -131,9 +134,14 @@ def interp_truth(gt, tq, max_gap=0.25):
 
 
 def read_mrclam(directory, robot, duration=None, keyframe_dt=0.5, noise="range",
-                max_gap=0.25, merge_dt=0.05, odom_scale=1.0, model=None) -> Dataset:
+                max_gap=0.25, merge_dt=0.05, odom_scale=1.0, model=None, odom_corr="state") -> Dataset:
     """`model`: a noise_model.NoiseModel for the measurement and odometry covariances (then
-    `noise` is not used), or None for the fixed models of the module text."""
+    `noise` is not used), or None for the fixed models of the module text. `odom_corr`: how a
+    model's odometry correlation in time is used: "state" (each step's error split into a white
+    part and a Gauss-Markov state shared by neighbouring steps, Step.odom_gm) or "inflate" (each
+    step's variance multiplied by its correlation sum, NoiseModel.odom_inflation)."""
+    if odom_corr not in ("state", "inflate"):
+        raise ValueError(f"unknown odometry correlation use {odom_corr!r}")
     d = directory
     for f in ("Barcodes.dat", "Landmark_Groundtruth.dat", f"Robot{robot}_Odometry.dat",
               f"Robot{robot}_Measurement.dat", f"Robot{robot}_Groundtruth.dat"):
@@ -191,6 +199,14 @@ def read_mrclam(directory, robot, duration=None, keyframe_dt=0.5, noise="range",
     n_no_truth = int(np.isnan(truth[:, 0]).sum())
     if n_no_truth:
         notes.append(f"{n_no_truth} of {len(times)} steps have no ground truth (Vicon gaps)")
+    gm = model is not None and model.odom_corr is not None and odom_corr == "state"
+    if gm:
+        # one state per exponential of the fitted correlation (a second only where a2 > 0)
+        comps = ("x", "y", "theta")
+        terms = [("a1", "tau1_s")] + ([("a2", "tau2_s")] if any(model.odom_corr[c]["a2"] > 0 for c in comps) else [])
+        a = np.concatenate([[model.odom_corr[c][ka] for c in comps] for ka, _ in terms])
+        tau = np.concatenate([[model.odom_corr[c][kt] for c in comps] for _, kt in terms])
+        a_sum = a.reshape(-1, 3).sum(0)
     oinfl = (model.odom_inflation(times) if model is not None and model.odom_corr is not None
              else np.ones((len(times), 3)))
     steps = []
@@ -200,6 +216,11 @@ def read_mrclam(directory, robot, duration=None, keyframe_dt=0.5, noise="range",
             inc = between(dr[k - 1], dr[k])
             if model is not None:
                 s.odom_cov = odom_scale ** 2 * model.odom_cov(inc, t - times[k - 1]) * oinfl[k]
+                if gm:
+                    # the batch's model (backend.odom_factors); the inflated odom_cov is iSAM2's online
+                    var = odom_scale ** 2 * np.diag(model.odom_cov(inc, t - times[k - 1]))
+                    s.odom_gm = (np.diag((1.0 - a_sum) * var), np.sqrt(a * np.tile(var, len(terms))),
+                                 np.exp(-(t - times[k - 1]) / tau) if k > 1 else np.zeros(len(a)))
             else:
                 sx, sy, st = (odom_scale * v for v in odom_sigmas(inc, t - times[k - 1]))
                 s.odom_cov = np.diag([sx * sx, sy * sy, st * st])

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import gtsam
 import numpy as np
 
-from .backend import Information, L, Slam, X, _poses, drop_reason
+from .backend import Information, L, Slam, X, Z, _poses, batch_optimize, drop_reason, odom_factors
 from .data import between
 
 from . import metrics
@@ -93,6 +93,7 @@ def run_multi(datasets, labels, params, progress=None) -> MultiResult:
     values = gtsam.Values()
     slam = Slam(params)
     n_obs = 0
+    n_states = 0                # odometry error states (odom_factors)
     for k in used:
         ds = datasets[k]
         base = k * ROBOT_STRIDE
@@ -104,8 +105,13 @@ def run_multi(datasets, labels, params, progress=None) -> MultiResult:
                 graph.add(gtsam.PriorFactorPose2(X(base), gtsam.Pose2(*start),
                                                  gtsam.noiseModel.Diagonal.Sigmas(np.array(params.prior_sigmas))))
             if i > 0:
-                graph.add(gtsam.BetweenFactorPose2(X(base + i - 1), X(base + i), gtsam.Pose2(*s.odom),
-                                                   slam._odom_noise(s.odom_cov)))
+                fs, vs = odom_factors(s, X(base + i - 1), X(base + i), Z(base + i - 1), Z(base + i),
+                                      ds.steps[i - 1].odom_gm is not None)
+                for f in fs:
+                    graph.add(f)
+                for key, v in vs:
+                    values.insert(key, v)
+                    n_states += 1
             for o in s.obs:
                 # the single-robot runs' rule; a landmark only those runs' dropped observations saw
                 # has no estimate, and its observations stay out too
@@ -117,17 +123,14 @@ def run_multi(datasets, labels, params, progress=None) -> MultiResult:
     for i, p in ref.items():
         values.insert(L(i), gtsam.Point2(*p))
     t_init = time.perf_counter() - t0
-    lp = gtsam.LevenbergMarquardtParams()
-    lp.setMaxIterations(100)
-    opt = gtsam.LevenbergMarquardtOptimizer(graph, values, lp)
-    est = opt.optimize()
+    est, iterations = batch_optimize(graph, values, python_loop=n_states > 0)
     marg = gtsam.Marginals(graph, est)
     poses = {labels[k]: _poses(est, len(datasets[k].steps), k * ROBOT_STRIDE) for k in used}
     lms = {i: np.array(est.atPoint2(L(i))) for i in ref}
     lm_cov = {i: marg.marginalCovariance(L(i)) for i in ref}
     stats = {"robots_used": [labels[k] for k in used], "observations_used": n_obs,
              "poses": sum(len(datasets[k].steps) for k in used), "landmarks": len(ref),
-             "batch_iterations": opt.iterations(), "final_error": graph.error(est),
+             "batch_iterations": iterations, "final_error": graph.error(est),
              "t_init_s": round(t_init, 3), "t_total_s": round(time.perf_counter() - t0, 3)}
     return MultiResult(robots=[labels[k] for k in used], poses=poses, lms=lms, lm_cov=lm_cov,
                        info=Information(graph, est), stats=stats, notes=notes)

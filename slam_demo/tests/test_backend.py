@@ -180,8 +180,8 @@ def test_mixed_association_uses_identities_where_given():
 
 
 def test_joint_nees_from_information_matches_dense_joint_covariance():
-    # A small graph with every kind of variable the back end makes (poses, landmarks, a vector
-    # state) and a robust kernel: e^T Sigma_S^-1 e from the sparse information matrix's Schur
+    # A small graph with every kind of variable the back end makes (poses, landmarks, odometry
+    # states, a vector state) and a robust kernel: e^T Sigma_S^-1 e from the sparse information matrix's Schur
     # complement equals the same with gtsam.Marginals' dense joint covariance, for pose subsets,
     # landmark sets and mixed sets.
     rng = np.random.default_rng(3)
@@ -198,8 +198,15 @@ def test_joint_nees_from_information_matches_dense_joint_covariance():
                                            gtsam.noiseModel.Diagonal.Sigmas([0.01, 0.05]))
     for i in range(6):
         if i:
-            g.add(gtsam.BetweenFactorPose2(backend.X(i - 1), backend.X(i), gtsam.Pose2(0.3, 0, 0.05),
-                                           gtsam.noiseModel.Diagonal.Sigmas([0.02, 0.01, 0.01])))
+            # odometry with two Gauss-Markov states per component (backend.odom_factors)
+            s = Step(t=float(i), seq=i, odom=np.array([0.3, 0, 0.05]), odom_cov=np.eye(3),
+                     odom_gm=(np.diag([0.02, 0.01, 0.01]) ** 2, np.full(6, 0.01),
+                              np.full(6, 0.7) if i > 1 else np.zeros(6)))
+            fs, vs = backend.odom_factors(s, backend.X(i - 1), backend.X(i), backend.Z(i - 1), backend.Z(i), i > 1)
+            for f in fs:
+                g.add(f)
+            for key, val in vs:
+                v.insert(key, val)
             v.insert(backend.X(i), gtsam.Pose2(0.3 * i, 0.01 * i, 0.05 * i))
         for j, p in enumerate(lms):
             pose = gtsam.Pose2(0.3 * i, 0, 0.05 * i)
@@ -214,7 +221,8 @@ def test_joint_nees_from_information_matches_dense_joint_covariance():
     info = backend.Information(g, est)
     marg = gtsam.Marginals(g, est)
     for keys in ([backend.X(i) for i in range(6)], [backend.X(1), backend.X(4)],
-                 [backend.L(j) for j in range(4)], [backend.L(2)], [backend.X(3), backend.L(1)]):
+                 [backend.L(j) for j in range(4)], [backend.L(2)], [backend.X(3), backend.L(1)],
+                 [backend.Z(2), backend.X(5)]):
         dense = marg.jointMarginalCovariance(gtsam.KeyVector(keys)).fullMatrix()
         e = rng.normal(0, 0.1, dense.shape[0])
         want = float(e @ np.linalg.solve(dense, e))

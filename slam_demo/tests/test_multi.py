@@ -113,6 +113,7 @@ def test_cli_multi_summary_has_what_the_summary_reads(tmp_path):
         assert s[k] is not None, k
     assert s["parameters"]["noise"] == "learned" and s["parameters"]["robust"] == "cauchy"
     assert s["parameters"]["reassoc"] == 0 and s["parameters"]["exclusion"] is False
+    assert s["parameters"]["odom_corr"] == "state"      # the one map carries the odometry's states
     assert s["multi_aligned_rmse_max_m"] < 0.2
     # an output directory that does not exist: refused before the run
     r = subprocess.run([sys.executable, "-m", "cylslam", "mrclam", "--dir", MR, "--robot", "2",

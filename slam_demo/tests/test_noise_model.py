@@ -116,6 +116,24 @@ def test_model_round_trip_and_strict_reading(tmp_path):
         open(q, "w").write(json.dumps(jj))
         with pytest.raises(nm.NoiseModelError, match=field.replace("(", r"\(").replace(")", r"\)")):
             nm.NoiseModel.load(q)
+    # version 2 needs the inflation's correlation; version 1 has none, and its one correlation
+    # serves both uses
+    jj = json.loads(json.dumps(j))
+    jj["odometry"].pop("inflation_correlation")
+    q = str(tmp_path / "v2.json")
+    open(q, "w").write(json.dumps(jj))
+    with pytest.raises(nm.NoiseModelError, match="odometry: missing key.*inflation_correlation"):
+        nm.NoiseModel.load(q)
+    corr = {c: {"a1": 0.5, "tau1_s": 3.0, "a2": 0.1, "tau2_s": 60.0} for c in ("x", "y", "theta")}
+    jj["odometry"]["correlation"] = corr
+    jj["version"] = 1
+    open(q, "w").write(json.dumps(jj))
+    m1 = nm.NoiseModel.load(q)
+    assert m1.odom_corr == corr and m1.odom_corr_inflation == corr
+    jj["odometry"]["inflation_correlation"] = corr
+    open(q, "w").write(json.dumps(jj))
+    with pytest.raises(nm.NoiseModelError, match="odometry: unknown key.*inflation_correlation"):
+        nm.NoiseModel.load(q)
     # a key twice in one object
     q = str(tmp_path / "dup.json")
     open(q, "w").write(open(p).read().replace('"b_r":', '"a_r_m": 1, "b_r":', 1))
