@@ -56,7 +56,8 @@ mrclam: $(VENV)/.stamp
 # slam_demo/cylslam/models/mrclam_noise.json was written by this, from ../shared's Dataset 7)
 mrclam-noise: $(VENV)/.stamp
 	@mkdir -p $(SLAM_OUT)
-	$(CYLSLAM) mrclam-noise --dir $(MRCLAM_DIR) --slam-check --out $(SLAM_OUT)/mrclam_noise.json
+	$(CYLSLAM) mrclam-noise --dir $(MRCLAM_DIR) --slam-check --out $(SLAM_OUT)/mrclam_noise.json \
+	  --plot $(SLAM_OUT)/mrclam_noise_correlation.png
 
 victoria: $(VENV)/.stamp
 	$(CYLSLAM) victoria --out $(SLAM_OUT)/victoria

@@ -714,6 +714,14 @@ def cmd_mrclam_noise(args):
             print(f"cylslam: error: {e}", file=sys.stderr)
             return EXIT_OUTPUT
         print(f"wrote {args.out}")
+    if args.plot:
+        from .plot import correlation_plot
+        try:
+            nm.write_text_safely(args.plot, correlation_plot(model))
+        except nm.NoiseModelError as e:
+            print(f"cylslam: error: {e}", file=sys.stderr)
+            return EXIT_OUTPUT
+        print(f"wrote {args.plot}")
     # the held-out check: the robots in two halves (1,3,5 / 2,4 for all five), each fitted on one
     # half and judged on the other
     halves = (tuple(robots[0::2]), tuple(robots[1::2]))
@@ -854,6 +862,8 @@ def build_parser():
     sp.add_argument("--out", default=None, help="write the model (JSON) here")
     sp.add_argument("--robots", default="1,2,3,4,5", help="robots to fit on (default %(default)s)")
     sp.add_argument("--no-cross-check", action="store_true", help="skip the held-out robot check")
+    sp.add_argument("--plot", default=None, metavar="FILE.png",
+                    help="also draw the fitted correlation in time against the measured lag bins (PNG)")
     sp.add_argument("--slam-check", action="store_true",
                     help="in the held-out check, also map each held-out robot with the model fitted without it "
                          "(known association) and print its RMSE and ANEES")

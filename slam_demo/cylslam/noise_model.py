@@ -336,7 +336,7 @@ class NoiseModel:
 
 
 def write_text_safely(path, text):
-    """Write an output file: through a temporary file renamed at the end when the target is a
+    """Write an output file (text, or bytes): through a temporary file renamed at the end when the target is a
     regular file (or does not exist; a symbolic link to a regular file replaces the file it points
     to), in place when it is a device node, FIFO or socket (/dev/null stays a device)."""
     import stat
@@ -355,12 +355,13 @@ def write_text_safely(path, text):
     if ls is not None and stat.S_ISDIR(ls.st_mode):
         raise NoiseModelError(f"{path}: is a directory, not an output file")
     try:
+        mode = "wb" if isinstance(text, bytes) else "w"     # bytes: an image
         if ls is not None and not stat.S_ISREG(ls.st_mode):
-            with open(path, "w") as fh:
+            with open(path, mode) as fh:
                 fh.write(text)
             return
         tmp = f"{target}.tmp{os.getpid()}"
-        with open(tmp, "w") as fh:
+        with open(tmp, mode) as fh:
             fh.write(text)
         os.replace(tmp, target)
     except OSError as e:

@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""PNG plot of the estimate against ground truth with 95 % ellipses."""
+"""PNG plots: the estimate against ground truth with 95 % ellipses; a noise model's correlation in
+time against the lag bins it was fitted to."""
 from __future__ import annotations
 
 import math
@@ -120,3 +121,48 @@ def plot(path, ds, res, title, res_fixed=None, dead_reckoning=None, match=None, 
     fig.tight_layout()
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
+
+
+def correlation_plot(model):
+    """PNG bytes: the noise model's correlation in time (provenance's lag bins, the empirical
+    correlation of the whitened errors) against the fitted curves, one panel per stream: range and
+    bearing (two exponentials), odometry x, y, theta (two exponentials, the batch's states; one, the
+    online inflation)."""
+    import io
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    pv = model.provenance
+    lags = np.asarray(pv.get("correlation_lags_s") or [], float)
+    panels = [("range", "correlation_range", model.corr, None),
+              ("bearing", "correlation_bearing", model.corr, None),
+              ("odometry x", "odometry_correlation_x", model.odom_corr, model.odom_corr_inflation),
+              ("odometry y", "odometry_correlation_y", model.odom_corr, model.odom_corr_inflation),
+              ("odometry theta", "odometry_correlation_theta", model.odom_corr, model.odom_corr_inflation)]
+    fig, axes = plt.subplots(1, 5, figsize=(17, 3.4), sharex=True)
+    t = np.geomspace(max(lags.min(), 0.05) if len(lags) else 0.1, max(lags.max(), 1.0) * 1.5 if len(lags) else 200, 200)
+    for ax, (title, key, fit, one) in zip(axes, panels):
+        comp = {"range": "range", "bearing": "bearing"}.get(title, title.split()[-1])
+        emp = np.array([np.nan if v is None else v for v in pv.get(key, [])], float)
+        if len(emp) == len(lags) and len(lags):
+            ax.plot(lags, emp, "o", ms=4, color="k", label="measured (lag bins)")
+        if fit is not None:
+            c = fit[comp]
+            ax.plot(t, c["a1"] * np.exp(-t / c["tau1_s"]) + c["a2"] * np.exp(-t / c["tau2_s"]), "-",
+                    color="tab:blue", label="two exponentials" + (" (states)" if one is not None else ""))
+        if one is not None:
+            c = one[comp]
+            ax.plot(t, c["a1"] * np.exp(-t / c["tau1_s"]) + c["a2"] * np.exp(-t / c["tau2_s"]), "--",
+                    color="tab:orange", label="one exponential (online inflation)")
+        ax.set_xscale("log")
+        ax.axhline(0.0, color="0.7", lw=0.8)
+        ax.set_title(title)
+        ax.set_xlabel("lag s")
+    axes[0].set_ylabel("correlation of whitened errors")
+    axes[2].legend(loc="upper right", fontsize=8)
+    fig.suptitle(f"noise model correlation in time ({pv.get('source', 'unknown source')})", fontsize=10)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return buf.getvalue()

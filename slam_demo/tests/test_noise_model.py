@@ -192,8 +192,14 @@ def test_cli_fits_on_the_fixture_and_maps_with_the_model(tmp_path):
     assert last["kernel"] in nm.KERNELS and last["fit_check"]["measurements"] > 100
     # one robot: no held-out check, said so; the model is written all the same
     os.unlink(out)
-    r = _cli("mrclam-noise", "--dir", MR, "--robots", "2", "--out", out)
+    png = str(tmp_path / "corr.png")
+    r = _cli("mrclam-noise", "--dir", MR, "--robots", "2", "--out", out, "--plot", png)
     assert r.returncode == 0 and "no held-out check" in r.stdout and os.path.exists(out), r.stderr
+    with open(png, "rb") as fh:
+        assert fh.read(8) == b"\x89PNG\r\n\x1a\n"
+    # the plot is an output like the model: a directory is refused with its name
+    r = _cli("mrclam-noise", "--dir", MR, "--robots", "2", "--no-cross-check", "--plot", str(tmp_path))
+    assert r.returncode == 4 and "is a directory" in r.stderr
     # robots the folder does not hold: a clear error, not a traceback
     r = _cli("mrclam-noise", "--dir", MR, "--robots", "1,2")
     assert r.returncode == 3 and "Robot1_Odometry.dat" in r.stderr and "Traceback" not in r.stderr
