@@ -208,8 +208,8 @@ def calib_prior(cov):
 
 
 def Z(i):
-    """Step i's time-correlated odometry error, unit variance per component (x, y, theta): a
-    Vector3 (Step.odom_gm)."""
+    """Step i's time-correlated odometry error, unit variance per component (x, y, theta) and
+    per exponential of the fitted correlation: a Vector of 3 values a term (Step.odom_gm)."""
     return gtsam.symbol("z", i)
 
 
