@@ -514,6 +514,11 @@ def cmd_mrclam(args):
     if args.noise != "learned" and args.noise_model is not None:
         print("cylslam: error: --noise-model needs --noise learned", file=sys.stderr)
         return EXIT_USAGE
+    if args.noise != "learned" and args.odom_corr is not None:
+        print("cylslam: error: --odom-corr needs --noise learned (the fixed models have no correlation)",
+              file=sys.stderr)
+        return EXIT_USAGE
+    args.odom_corr = args.odom_corr or "state"
     if args.summary_out and not os.path.isdir(os.path.dirname(os.path.abspath(args.summary_out))):
         print(f"cylslam: error: --summary-out {args.summary_out}: no such directory", file=sys.stderr)
         return EXIT_OUTPUT
@@ -833,11 +838,11 @@ def build_parser():
                          "on Dataset 7 and shipped with cylslam, cylslam/models/mrclam_noise.json)")
     sp.add_argument("--odom-scale", type=float, default=1.0,
                     help="multiply the odometry sigmas by this (default %(default)s)")
-    sp.add_argument("--odom-corr", choices=["state", "inflate"], default="state",
+    sp.add_argument("--odom-corr", choices=["state", "inflate"], default=None,
                     help="with --noise learned, how the model's odometry correlation in time is used: state "
                          "(the batch solution carries each step's correlated error as a Gauss-Markov state "
                          "shared by neighbouring steps) or inflate (each step's variance multiplied by its "
-                         "correlation sum, as iSAM2 uses it online) (default %(default)s)")
+                         "correlation sum, as iSAM2 uses it online) (default state)")
     sp.add_argument("--multi", action="store_true",
                     help="also map all the robots together: one graph, shared landmarks, the start poses "
                          "of all robots but the first unknown (known association)")

@@ -123,6 +123,10 @@ def test_cli_multi_summary_has_what_the_summary_reads(tmp_path):
     r = subprocess.run([sys.executable, "-m", "cylslam", "mrclam", "--dir", MR, "--robot", "2",
                         "--noise-model", str(out)], capture_output=True, text=True, env=env)
     assert r.returncode == 2 and "--noise learned" in r.stderr
+    # --odom-corr without --noise learned: the fixed models have no correlation to use
+    r = subprocess.run([sys.executable, "-m", "cylslam", "mrclam", "--dir", MR, "--robot", "2",
+                        "--odom-corr", "inflate"], capture_output=True, text=True, env=env)
+    assert r.returncode == 2 and "--odom-corr needs --noise learned" in r.stderr
 
 
 def test_robots_with_identities_on_some_observations_only():
