@@ -308,6 +308,12 @@ def batch_optimize(graph, values, max_iter=100, python_loop=False):
     return v, it
 
 
+def _covs_by_observation(frames):
+    """{id(observation): its covariance} over the frames' usable observations (Slam._run's
+    `frames`: (step, observations, covariances))."""
+    return {id(o): c for (_, u, cs) in frames for o, c in zip(u, cs)}
+
+
 BIG = 1e9      # an assignment cost that stands for "not allowed" (Hungarian cost matrices)
 
 
@@ -623,20 +629,24 @@ class Slam:
             if i > 0:
                 if s.odom is None:
                     raise ValueError(f"step {i} has no odometry")
-                # the batch graph has the odometry's correlated error as states where the step
-                # carries them (odom_factors); iSAM2, online, each step's inflated variance
-                gm_prev = steps[i - 1].odom_gm is not None
-                fs, vs = odom_factors(s, X(i - 1), X(i), Z(i - 1), Z(i), gm_prev)
-                base_states.extend(fs)
-                z_init.extend(vs)
-                if not states_in_batch:
-                    fs, _ = odom_factors(s, X(i - 1), X(i), Z(i - 1), Z(i), gm_prev, state=False)
-                base_f.extend(fs)
-                if scale != 1.0:             # this pass's gating only: the re-association's graph has fs
-                    fs, _ = odom_factors(s, X(i - 1), X(i), Z(i - 1), Z(i), gm_prev, scale, state=states_in_batch)
-                for f in fs:
+                # iSAM2, online, has each step's inflated variance; the batch graph the odometry's
+                # correlated error as states where the step carries them (odom_factors). The
+                # gating scale is this pass's only: base_f (the re-association's) is unscaled
+                keys = (X(i - 1), X(i), Z(i - 1), Z(i), steps[i - 1].odom_gm is not None)
+                online = odom_factors(s, *keys, scale, state=False)[0]
+                if with_states:
+                    fs, vs = odom_factors(s, *keys)
+                    base_states.extend(fs)
+                    z_init.extend(vs)
+                if states_in_batch:
+                    base_f.extend(fs)
+                    batch = fs if scale == 1.0 else odom_factors(s, *keys, scale)[0]
+                else:
+                    base_f.extend(online if scale == 1.0 else odom_factors(s, *keys, state=False)[0])
+                    batch = online
+                for f in batch:
                     graph.add(f)
-                for f in odom_factors(s, X(i - 1), X(i), Z(i - 1), Z(i), gm_prev, scale, state=False)[0]:
+                for f in online:
                     new_f.add(f)
                 cur = compose(cur, s.odom)
                 new_v.insert(X(i), gtsam.Pose2(*cur))
@@ -731,7 +741,7 @@ class Slam:
         if states_in_batch:
             for key, v in z_init:
                 est.insert(key, v)
-        st["odometry_states"] = len(z_init) if with_states else 0
+        st["odometry_states"] = len(z_init)
         if p.batch:
             est, st["batch_iterations"] = batch_optimize(graph, est, python_loop=states_in_batch)
         removed = set()
@@ -743,7 +753,7 @@ class Slam:
             st["assoc_cost"] = (st["assoc_error"] + (n_frames_obs - len(assoc)) * gate / 2
                                 + len({j for (_, _, j) in assoc}) * math.log(max(len(assoc), 2)))
             if with_states:                  # the last solve, on the pairings made
-                cov_of = {id(o): c for (_, u, cs) in frames for o, c in zip(u, cs)}
+                cov_of = _covs_by_observation(frames)
                 graph, est = self._solve_pairings(base_states, est, [(i, o, cov_of[id(o)], j) for (i, o, j) in assoc],
                                                   z_init)
         st["odom_sigma_scale"] = scale
@@ -781,11 +791,11 @@ class Slam:
                       lm_cov=lm_cov, lm_class=lm_class, lm_ids=lm_ids, assoc=assoc, stats=st,
                       info=info, lm_keys=lm_keys)
 
-    def _solve_pairings(self, base_f, est, pairs, extra=()):
+    def _solve_pairings(self, base_f, est, pairs, states=()):
         """The graph of `base_f` and one range-bearing factor per (step, observation, covariance,
-        landmark) of `pairs`, solved by Levenberg-Marquardt from `est` (poses, odometry states, and
-        the landmarks the pairs name; `extra`: (key, value) pairs for variables `est` lacks):
-        (graph, estimate)."""
+        landmark) of `pairs`, solved by Levenberg-Marquardt from `est` (poses, and the landmarks
+        the pairs name) and, when `base_f` holds odometry states, their (key, initial value) pairs
+        `states`: (graph, estimate)."""
         graph = gtsam.NonlinearFactorGraph()
         for f in base_f:
             graph.add(f)
@@ -798,14 +808,11 @@ class Slam:
             sym = gtsam.Symbol(key)
             if sym.chr() == ord("x"):
                 v.insert(key, est.atPose2(key))
-            elif sym.chr() == ord("z"):
-                v.insert(key, est.atVector(key))
             elif sym.index() in used:
                 v.insert(key, est.atPoint2(key))
-        for key, val in extra:
-            if not v.exists(key):
-                v.insert(key, val)
-        return graph, batch_optimize(graph, v, python_loop=any(chr(gtsam.Symbol(k).chr()) == "z" for k in v.keys()))[0]
+        for key, val in states:
+            v.insert(key, val)
+        return graph, batch_optimize(graph, v, python_loop=bool(states))[0]
 
     def _reassociate(self, frames, base_f, est, graph, assoc, lm_class, merged_into, gate, st, rebuild=False):
         """Batch re-association (`reassoc` passes at most): every usable observation of every frame
@@ -825,7 +832,7 @@ class Slam:
         estimate, the pairings and the removed landmarks."""
         p = self.p
         if rebuild:
-            cov_of = {id(o): c for (_, u, cs) in frames for o, c in zip(u, cs)}
+            cov_of = _covs_by_observation(frames)
             graph, est = self._solve_pairings(base_f, est, [(i, o, cov_of[id(o)], _root(merged_into, j))
                                                             for (i, o, j) in assoc])
         lms = sorted({_root(merged_into, j) for (_, _, j) in assoc})
@@ -1146,13 +1153,15 @@ class Information:
         self.H = (J.T @ J).tocsc()
         self.n = c
         # an elimination order for the Schur complements in `nees`: each pose next to its odometry
-        # state, step by step (a chain: banded), the other variables (landmarks, calibration) last
-        self.rank = np.empty(c)
+        # state, step by step (a chain: banded), the other variables (landmarks, calibration) last,
+        # in column order: (group, step, pose before state, column) sorted together
+        self.rank = np.empty((c, 4), np.int64)
         for k in keys:
             sym = gtsam.Symbol(k)
             ch = chr(sym.chr())
-            r = 2.0 * sym.index() + (ch == "z") if ch in "xz" else 1e18 + self.cols[k][0]
-            self.rank[self.cols[k]] = r + np.arange(len(self.cols[k])) * 1e-3
+            chain = ch in "xz"
+            self.rank[self.cols[k]] = [[0 if chain else 1, sym.index() if chain else 0, ch == "z", col]
+                                       for col in self.cols[k]]
 
     def columns(self, keys):
         return np.concatenate([self.cols[k] for k in keys]) if keys else np.zeros(0, int)
@@ -1167,7 +1176,8 @@ class Information:
         e = np.asarray(err, float)
         v = float(e @ (self.H[s][:, s] @ e))
         if len(o):
-            o = o[np.argsort(self.rank[o], kind="stable")]
+            r = self.rank[o]
+            o = o[np.lexsort((r[:, 3], r[:, 2], r[:, 1], r[:, 0]))]
             Hos = self.H[o][:, s]
             w = Hos @ e
             Hoo = sp.csc_matrix(self.H[o][:, o])

@@ -48,10 +48,11 @@ class Step:
     odom: Optional[np.ndarray] = None       # (dx, dy, dtheta) from previous step, None for step 0
     odom_cov: Optional[np.ndarray] = None   # 3x3
     # the step's time-correlated odometry error as a state (backend.odom_factors), or None:
-    # (white, sd, phi): white the 3x3 covariance of the uncorrelated part; sd (3,) m, m, rad the
-    # correlated part's standard deviation in x, y, theta; phi (3,) its correlation with the
-    # previous step's (exp(-dt / tau), 0 at the first step). odom_cov stays the whole error's
-    # covariance, inflated by its correlation sum: what an online solver (iSAM2) uses
+    # (white, sd, phi): white the 3x3 covariance of the uncorrelated part; sd (3 m,) m, m, rad the
+    # standard deviations in x, y, theta of the m correlated terms, one after the other; phi (3 m,)
+    # each term's correlation with the previous step's (exp(-dt / tau), 0 at the first step).
+    # odom_cov stays the whole error's covariance, inflated by its correlation sum: what an online
+    # solver (iSAM2) uses
     odom_gm: Optional[tuple] = None
     obs: list = field(default_factory=list)
     truth: Optional[np.ndarray] = None      # true (x, y, theta) or None

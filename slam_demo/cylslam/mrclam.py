@@ -215,10 +215,11 @@ def read_mrclam(directory, robot, duration=None, keyframe_dt=0.5, noise="range",
         if k > 0:
             inc = between(dr[k - 1], dr[k])
             if model is not None:
-                s.odom_cov = odom_scale ** 2 * model.odom_cov(inc, t - times[k - 1]) * oinfl[k]
+                cov = odom_scale ** 2 * model.odom_cov(inc, t - times[k - 1])
+                s.odom_cov = cov * oinfl[k]
                 if gm:
                     # the batch's model (backend.odom_factors); the inflated odom_cov is iSAM2's online
-                    var = odom_scale ** 2 * np.diag(model.odom_cov(inc, t - times[k - 1]))
+                    var = np.diag(cov)
                     s.odom_gm = (np.diag((1.0 - a_sum) * var), np.sqrt(a * np.tile(var, len(terms))),
                                  np.exp(-(t - times[k - 1]) / tau) if k > 1 else np.zeros(len(a)))
             else:

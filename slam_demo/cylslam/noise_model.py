@@ -187,7 +187,8 @@ class NoiseModel:
         return ("none", 1.0) if self.kernel == "gaussian" else (self.kernel, self.kernel_k)
 
     @staticmethod
-    def _rho(c, dt):
+    def correlation_at(c, dt):
+        """rho(dt) = a1 exp(-|dt| / tau1) + a2 exp(-|dt| / tau2) of one component's fit `c`."""
         dt = np.abs(dt)
         return c["a1"] * np.exp(-dt / c["tau1_s"]) + c["a2"] * np.exp(-dt / c["tau2_s"])
 
@@ -203,7 +204,7 @@ class NoiseModel:
             for i in range(len(t)):
                 # correlations below 1e-3 are left out (the window keeps the sum linear in n)
                 lo, hi = np.searchsorted(t, [t[i] - 50.0 * corr[comp]["tau2_s"], t[i] + 50.0 * corr[comp]["tau2_s"]])
-                r = NoiseModel._rho(corr[comp], t[lo:hi] - t[i])
+                r = NoiseModel.correlation_at(corr[comp], t[lo:hi] - t[i])
                 r[i - lo] = 1.0
                 out[i, c] = float(np.sum(r[(r >= 1e-3)]))
         back = np.empty_like(out)
@@ -668,7 +669,7 @@ def fit(read, source):
     comps = ("x", "y", "theta")
     odom_corr = {comp: fit_correlation(oc, on, orho[ci]) for ci, comp in enumerate(comps)}
     odom_corr_inflation = {comp: fit_correlation(oc, on, orho[ci], terms=1) for ci, comp in enumerate(comps)}
-    for ci, comp in enumerate(("x", "y", "theta")):
+    for ci, comp in enumerate(comps):
         prov[f"odometry_correlation_{comp}"] = [None if not np.isfinite(x) else round(float(x), 3) for x in orho[ci]]
     model = NoiseModel(meas, per_o[chosen_o]["model"], chosen, c["kernel_k"], chosen_o, per_o[chosen_o]["kernel_k"],
                        prov, scales, delay, corr, odom_corr, odom_corr_inflation)

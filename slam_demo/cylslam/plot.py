@@ -133,28 +133,28 @@ def correlation_plot(model):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from .noise_model import NoiseModel
     pv = model.provenance
     lags = np.asarray(pv.get("correlation_lags_s") or [], float)
-    panels = [("range", "correlation_range", model.corr, None),
-              ("bearing", "correlation_bearing", model.corr, None),
-              ("odometry x", "odometry_correlation_x", model.odom_corr, model.odom_corr_inflation),
-              ("odometry y", "odometry_correlation_y", model.odom_corr, model.odom_corr_inflation),
-              ("odometry theta", "odometry_correlation_theta", model.odom_corr, model.odom_corr_inflation)]
+    odom = (model.odom_corr, model.odom_corr_inflation)
+    panels = [("range", "range", "correlation_range", (model.corr, None)),
+              ("bearing", "bearing", "correlation_bearing", (model.corr, None)),
+              ("odometry x", "x", "odometry_correlation_x", odom),
+              ("odometry y", "y", "odometry_correlation_y", odom),
+              ("odometry theta", "theta", "odometry_correlation_theta", odom)]
     fig, axes = plt.subplots(1, 5, figsize=(17, 3.4), sharex=True)
     t = np.geomspace(max(lags.min(), 0.05) if len(lags) else 0.1, max(lags.max(), 1.0) * 1.5 if len(lags) else 200, 200)
-    for ax, (title, key, fit, one) in zip(axes, panels):
-        comp = {"range": "range", "bearing": "bearing"}.get(title, title.split()[-1])
+    for ax, (title, comp, key, (fit, one)) in zip(axes, panels):
         emp = np.array([np.nan if v is None else v for v in pv.get(key, [])], float)
         if len(emp) == len(lags) and len(lags):
             ax.plot(lags, emp, "o", ms=4, color="k", label="measured (lag bins)")
         if fit is not None:
-            c = fit[comp]
-            ax.plot(t, c["a1"] * np.exp(-t / c["tau1_s"]) + c["a2"] * np.exp(-t / c["tau2_s"]), "-",
-                    color="tab:blue", label="two exponentials" + (" (states)" if one is not None else ""))
+            ax.plot(t, NoiseModel.correlation_at(fit[comp], t), "-", color="tab:blue",
+                    label="two exponentials" + (" (states)" if one is not None else ""))
         if one is not None:
-            c = one[comp]
-            ax.plot(t, c["a1"] * np.exp(-t / c["tau1_s"]) + c["a2"] * np.exp(-t / c["tau2_s"]), "--",
-                    color="tab:orange", label="one exponential (online inflation)")
+            ax.plot(t, NoiseModel.correlation_at(one[comp], t), "--", color="tab:orange",
+                    label="one exponential (online inflation)")
         ax.set_xscale("log")
         ax.axhline(0.0, color="0.7", lw=0.8)
         ax.set_title(title)
