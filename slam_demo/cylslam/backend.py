@@ -111,16 +111,25 @@ def rb_jacobians(pose, lm):
     return b, r, hp, hl
 
 
-def calib_factor(pose_key, lm_key, o, noise, bias_key=None):
+def _key_list(keys):
+    """None, one key or several: a list of keys."""
+    if keys is None:
+        return []
+    return [keys] if isinstance(keys, (int, np.integer)) else list(keys)
+
+
+def calib_factor(pose_key, lm_key, o, noise, bias_keys=()):
     """An observation with the calibration error as a state (docs/uncertainty.md, "Constant
     calibration errors"): the frontend computed z with the nominal calibration, so
     z = h(pose, lm) - J delta + n, with delta = true - nominal calibration, J = o.jac_calib and
     n ~ N(0, o.cov_frame). Residual in GTSAM's (bearing, range) order.
 
-    With bias_key, the landmark's centroid bias b = (du, dv) px (one per landmark, see
+    With bias keys, the landmark's centroid bias b = (du, dv) px (one per landmark, see
     Params.lm_bias) is a state too: range and bearing depend on the centroid through
     (u - cx, v - cy), so a centroid moved by b reads as a principal-point error of b:
-    z = h - J delta - J_cxcy b + n."""
+    z = h - J delta - J_cxcy b + n. bias_keys: the bias states (Vector2, px) whose sum is b (the
+    landmark's constant one and the observation's time-correlated one, G)."""
+    bias_keys = _key_list(bias_keys)
     jbr = np.vstack([o.jac_calib[1], o.jac_calib[0]])   # (bearing, range) rows
     jpx = jbr[:, 2:4]                                   # d(bearing, range)/d(cx, cy)
 
@@ -130,22 +139,22 @@ def calib_factor(pose_key, lm_key, o, noise, bias_key=None):
         d = values.atVector(CALIB)
         b, r, hp, hl = rb_jacobians((p.x(), p.y(), p.theta()), (l[0], l[1]))
         e = np.array([b, r]) - jbr @ d - np.array([o.bearing_rad, o.range_m])
-        if bias_key is not None:
-            e = e - jpx @ values.atVector(bias_key)
+        for bk in bias_keys:
+            e = e - jpx @ values.atVector(bk)
         e[0] = (e[0] + np.pi) % (2 * np.pi) - np.pi
         if H is not None:
             H[0] = hp
             H[1] = hl
             H[2] = -jbr
-            if bias_key is not None:
-                H[3] = -jpx
+            for n in range(len(bias_keys)):
+                H[3 + n] = -jpx
         return e
 
-    keys = [pose_key, lm_key, CALIB] + ([bias_key] if bias_key is not None else [])
+    keys = [pose_key, lm_key, CALIB] + list(bias_keys)
     return gtsam.CustomFactor(noise, keys, error)
 
 
-def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_key=None):
+def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_keys=()):
     """As calib_factor, with libcyl's camera model evaluated at the estimated calibration instead of
     its linearisation at the nominal one (rbm: camera_model.range_bearing_model). The predicted
     measurement is m(delta, b) = cyl_rb_eval(u - du, v - dv, nominal + delta), so z = h(pose, lm) + n
@@ -160,6 +169,7 @@ def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_ke
     estimated calibration gives the pixel, not the nominal one's. The bias state enters with the
     identity (it is a pixel offset). Where the model has no range for a delta the optimiser tries (the
     ray at or above the horizon), the linearisation at the nominal calibration stands in."""
+    bias_keys = _key_list(bias_keys)
     jbr = np.vstack([o.jac_calib[1], o.jac_calib[0]])   # (bearing, range) rows, at the nominal
     a0 = -jbr[:, 2:4]                                   # d(bearing, range)/d(u, v) = -d/d(cx, cy)
     a0i = np.linalg.inv(a0)
@@ -175,7 +185,9 @@ def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_ke
         p = values.atPose2(pose_key)
         l = values.atPoint2(lm_key)
         d = values.atVector(CALIB)
-        bb = values.atVector(bias_key) if bias_key is not None else np.zeros(2)
+        bb = np.zeros(2)
+        for bk in bias_keys:
+            bb = bb + values.atVector(bk)
         b, r, hp, hl = rb_jacobians((p.x(), p.y(), p.theta()), (l[0], l[1]))
         m = rbm.eval(o.u_px - bb[0], o.v_px - bb[1], d)
         if m is not None:
@@ -192,11 +204,11 @@ def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_ke
             H[0] = ai @ hp
             H[1] = ai @ hl
             H[2] = -ai @ jd
-            if bias_key is not None:
-                H[3] = np.eye(2)                         # zhat(u - b): d e / d b = A^-1 A (A^-1 held, Gauss-Newton)
+            for n in range(len(bias_keys)):
+                H[3 + n] = np.eye(2)                     # zhat(u - b): d e / d b = A^-1 A (A^-1 held, Gauss-Newton)
         return ai @ e
 
-    keys = [pose_key, lm_key, CALIB] + ([bias_key] if bias_key is not None else [])
+    keys = [pose_key, lm_key, CALIB] + list(bias_keys)
     return gtsam.CustomFactor(noise, keys, error)
 
 
@@ -205,6 +217,29 @@ def calib_prior(cov):
     get a tiny one (1e-12 of the unit) so that the prior stays invertible."""
     c = np.array(cov, float) + np.diag(np.where(np.diag(cov) > 0, 0.0, 1e-24))
     return gtsam.PriorFactorVector(CALIB, np.zeros(8), gtsam.noiseModel.Gaussian.Covariance(c))
+
+
+def G(n):
+    """The n-th used observation's time-correlated centroid bias (du, dv) px: a Vector2
+    (Params.bias_gm_sigma_px; gm_chain_factor)."""
+    return gtsam.symbol("g", n)
+
+
+def gm_chain_factor(g_prev, g, phi, q_var):
+    """Two consecutive time-correlated biases of one landmark's observations, a first-order
+    Gauss-Markov process per axis: g - phi g_prev ~ N(0, diag(q_var)), phi = exp(-dt / tau) and
+    q_var = sigma^2 (1 - phi^2), so the process keeps its variance sigma^2 and its correlation
+    exp(-|dt| / tau)."""
+    phi = np.asarray(phi, float)
+    noise = gtsam.noiseModel.Diagonal.Variances(np.maximum(np.asarray(q_var, float), 1e-12))
+
+    def error(this, values, H):
+        if H is not None:
+            H[0] = -np.diag(phi)
+            H[1] = np.eye(2)
+        return values.atVector(g) - phi * values.atVector(g_prev)
+
+    return gtsam.CustomFactor(noise, [g_prev, g], error)
 
 
 def Z(i):
@@ -383,6 +418,12 @@ class Params:
                                    # observation that starts it, taken out of each cov_frame) |
                                    # none (white noise like the rest of cov_frame) | auto (state
                                    # where the observation that starts a landmark has the field)
+    bias_gm_sigma_px: tuple = (0.0, 0.0)  # with a bias state: the centroid's time-correlated bias
+                                   # (u, v) px, a Gauss-Markov state per observation chained along each
+                                   # landmark's observations (G, gm_chain_factor); (0, 0): none
+    bias_gm_tau_s: tuple = (3.0, 10.0)    # its correlation time (u, v), s
+    white_scale: tuple = (1.0, 1.0)       # with the time-correlated bias: the frame's white centroid
+                                   # variance (the log's less the bias's) times this (u, v)
 
     def check(self):
         """The batch re-association's and the starts' constraints: ValueError naming the option
@@ -550,6 +591,17 @@ class Slam:
         if p.lm_bias not in ("auto", "none", "state"):
             raise ValueError(f"unknown landmark bias model {p.lm_bias!r}")
         lm_bias = {}                        # landmark -> its bias state's prior variance (u, v) px^2, or None
+        lm_gm = {}                          # landmark -> (its latest time-correlated bias key, that step's t)
+        gm_sig = np.asarray(p.bias_gm_sigma_px, float)
+        gm_tau = np.asarray(p.bias_gm_tau_s, float)
+        if gm_sig.shape != (2,) or gm_tau.shape != (2,) or np.any(~(gm_sig >= 0)) or np.any(~(gm_tau > 0)):
+            raise ValueError(f"--bias-gm {tuple(gm_sig)} / --bias-gm-tau {tuple(gm_tau)}: two sigmas >= 0 px "
+                             "and two correlation times > 0 s")
+        use_gm = bool(np.any(gm_sig > 0))
+        if use_gm and (not p.calib_states or p.lm_bias == "none"):
+            raise ValueError("--bias-gm: the time-correlated bias goes with the landmark's bias state "
+                             "(--calib-states, and not --lm-bias none)")
+        use_gm = use_gm and use_calib       # the fixed-covariance runs replace the whole covariance
         cur = start.copy()                  # current estimate of the newest pose
         lms_init = []                       # initial/latest estimate per landmark
         lm_class, lm_ids = [], []
@@ -558,7 +610,7 @@ class Slam:
         assoc = []
         st = dict(obs_total=0, dropped_flags=0, dropped_no_range=0, dropped_confidence=0, dropped_far=0,
                   dropped_ambiguous=0, dropped_imprecise=0, used=0, new_landmarks=0, isam_updates=0,
-                  marginal_calls=0, new_by_exclusion=0, dropped_unconfirmed=0, association=mode, by_identity=0, bias_states=0, exact_factors=0)
+                  marginal_calls=0, new_by_exclusion=0, dropped_unconfirmed=0, association=mode, by_identity=0, bias_states=0, exact_factors=0, gm_states=0)
         last_update = 0
         merged_into = {}                    # landmark -> the landmark it was merged into
         co_seen = set()                     # (j, k), j < k: landmarks observed in one frame
@@ -600,9 +652,39 @@ class Slam:
                     # it as the state's prior covers
                     jpx = o.jac_calib[:, 2:4]
                     cf = cf - jpx @ np.diag(np.minimum(o.bias_var_px2, lm_bias[j])) @ jpx.T
+                    if use_gm:
+                        # the rest is the frame's white noise and the time-correlated bias: the
+                        # white part, scaled, stays here; the other is the G state's
+                        ji = np.linalg.inv(jpx)
+                        var_px = np.maximum(np.diag(ji @ cf @ ji.T), 1e-8) * np.asarray(p.white_scale, float)
+                        cf = jpx @ np.diag(var_px) @ jpx.T
                 if p.fixed_frame_cov is not None:
                     cf = p.fixed_frame_cov
-                bk = B(j) if lm_bias[j] is not None else None
+                bk = []
+                if use_gm and lm_bias[j] is None:
+                    raise ValueError(f"{o.where}: --bias-gm needs the observation's bias_var_px2 (the "
+                                     "landmark's bias state)")
+                if lm_bias[j] is not None:
+                    bk = [B(j)]
+                    if use_gm:
+                        t = steps[k].t
+                        prev = lm_gm.get(j)
+                        if prev is not None and t == prev[1]:
+                            gk = prev[0]             # two blobs of one landmark in one frame
+                        else:
+                            gk = G(st["gm_states"])
+                            st["gm_states"] += 1
+                            new_v.insert(gk, np.zeros(2))
+                            if prev is None:
+                                fg = gtsam.PriorFactorVector(gk, np.zeros(2), gtsam.noiseModel.Diagonal.Variances(
+                                    np.maximum(gm_sig ** 2, 1e-12)))
+                            else:
+                                phi = np.exp(-abs(t - prev[1]) / gm_tau)
+                                fg = gm_chain_factor(prev[0], gk, phi, gm_sig ** 2 * (1 - phi ** 2))
+                            graph.add(fg)
+                            new_f.add(fg)
+                            lm_gm[j] = (gk, t)
+                        bk.append(gk)
                 if rbm is not None:
                     if o.u_px is None:
                         raise ValueError(f"{o.where}: --calib-model exact needs the observation's u_px, v_px")

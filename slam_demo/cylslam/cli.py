@@ -55,6 +55,15 @@ def _scales(text):
     return v
 
 
+def _pair(text):
+    """'a,b' -> (a, b) floats (a command-line value of two numbers)."""
+    try:
+        a, b = (float(x) for x in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected two numbers 'a,b', got '{text}'")
+    return (a, b)
+
+
 def _reassoc_conflict(args):
     """The run's parameters break a constraint of Params.check: the message, True."""
     try:
@@ -75,6 +84,9 @@ def _params(args, **over):
                reassoc=getattr(args, "reassoc", 0), starts=tuple(getattr(args, "starts", None) or (1.0,)),
                calib_states=getattr(args, "calib_states", False),
                lm_bias=getattr(args, "lm_bias", "auto"),
+               bias_gm_sigma_px=tuple(getattr(args, "bias_gm", None) or (0.0, 0.0)),
+               bias_gm_tau_s=tuple(getattr(args, "bias_gm_tau", None) or (3.0, 10.0)),
+               white_scale=tuple(getattr(args, "white_scale", None) or (1.0, 1.0)),
                calib_model=getattr(args, "calib_model", "linear"),
                max_range_rel_sigma=(None if getattr(args, "max_range_rel_sigma", None) in (None, 0)
                                     else args.max_range_rel_sigma))
@@ -416,6 +428,13 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
                         "as one state per landmark shared by its observations (state), or as white "
                         "noise in each frame like the rest of cov_frame (none); auto: state where "
                         "the log has the field (default %(default)s)")
+    g.add_argument("--bias-gm", type=_pair, default=None, metavar="SU,SV",
+                   help="with a bias state: the centroid's time-correlated bias, px (u, v), as a "
+                        "Gauss-Markov state per observation chained along each landmark's views")
+    g.add_argument("--bias-gm-tau", type=_pair, default=None, metavar="TU,TV",
+                   help="its correlation times, s (u, v; default 3,10)")
+    g.add_argument("--white-scale", type=_pair, default=None, metavar="KU,KV",
+                   help="with --bias-gm: the frame's white centroid variance times these (default 1,1)")
     g.add_argument("--fixed-cov", choices=["grid", "mean", "frame-grid", "none"], default=fixed_default,
                    help="side-by-side run with ONE fixed observation covariance: the mean of the "
                         "per-observation covariances (mean), or the best of 0.25..4 x that mean by "

@@ -203,7 +203,7 @@ def test_exact_factor_jacobians_match_central_differences():
     from cylslam.backend import B, calib_factor_exact
     d0 = np.array([0.3, -0.2, 0.4, 0.1, np.radians(0.5), np.radians(0.2), 0.001, 0.002])
     rbm, o, pose, lm, _ = _exact_setup(u=420.0, v=190.0, d_true=d0)
-    f = calib_factor_exact(X(0), L(0), o, o.cov_frame, rbm, bias_key=B(0))
+    f = calib_factor_exact(X(0), L(0), o, o.cov_frame, rbm, bias_keys=[B(0)])
     moved = dict(pose=pose + [0.01, -0.02, 0.003], lm=lm + [0.03, -0.01], d=d0 * 0.7, b=np.array([0.2, -0.3]))
     at_zero = dict(pose=pose, lm=lm, d=d0, b=np.zeros(2))
 

@@ -55,11 +55,18 @@ def test_bias_factor_residual_and_jacobian():
     assert np.allclose(num, w @ -np.vstack([JPX[1], JPX[0]]), rtol=1e-6)
 
 
-def _drive(rng, var_white, var_bias, steps=80):
-    """A robot on a circle among four landmarks, each seen every step. Each landmark's observations
-    share one centroid error drawn from N(0, var_bias); each frame adds N(0, var_white)."""
+def _drive(rng, var_white, var_bias, steps=80, drift=None, dt=0.1):
+    """A robot on a circle among four landmarks, each seen every step (dt s apart). Each landmark's
+    observations share one centroid error drawn from N(0, var_bias); each frame adds N(0, var_white).
+    drift = (sigma px, tau s) per axis adds a Gauss-Markov drift per landmark, which the frontend's
+    variance (cov_frame) does not cover."""
     lms = np.array([[3.0, 0.5], [-2.5, 2.0], [0.5, -3.0], [-1.0, -2.8]])
     bias = rng.normal(size=(len(lms), 2)) * np.sqrt(var_bias)
+    g = np.zeros((len(lms), 2))
+    if drift is not None:
+        sigma_g, tau_s = (np.asarray(x, float) for x in drift)
+        phi = np.exp(-dt / tau_s)
+        g = rng.normal(size=g.shape) * sigma_g
     q = np.diag([0.01 ** 2, 0.005 ** 2, 0.004 ** 2])
     truth = [np.array([1.5, 0.0, np.pi / 2])]
     odo = [None]
@@ -70,13 +77,15 @@ def _drive(rng, var_white, var_bias, steps=80):
     cov_frame = JPX @ np.diag(var_white + var_bias) @ JPX.T
     out = []
     for k, p in enumerate(truth):
+        if k and drift is not None:
+            g = phi * g + rng.normal(size=g.shape) * sigma_g * np.sqrt(1 - phi ** 2)
         obs = []
         for j, lm in enumerate(lms):
             b, r, _, _ = rb_jacobians(p, lm)
-            z = np.array([r, b]) - JPX @ (bias[j] + rng.normal(size=2) * np.sqrt(var_white))
+            z = np.array([r, b]) - JPX @ (bias[j] + g[j] + rng.normal(size=2) * np.sqrt(var_white))
             obs.append(Obs(cls="orange", range_m=z[0], bearing_rad=float(wrap(z[1])), cov=cov_frame,
                            lm_id=j, jac_calib=_jac(), cov_frame=cov_frame, bias_var_px2=var_bias.copy()))
-        out.append(Step(t=0.1 * k, seq=k, odom=odo[k], odom_cov=None if k == 0 else q, truth=p, obs=obs))
+        out.append(Step(t=dt * k, seq=k, odom=odo[k], odom_cov=None if k == 0 else q, truth=p, obs=obs))
     ds = Dataset(name="bias", steps=out, truth_landmarks={j: (*lm, "orange") for j, lm in enumerate(lms)},
                  classes=["orange"], known_ids=True)
     ds.calib_cov = np.zeros((8, 8))   # the calibration known exactly: only the bias is unmodelled
