@@ -225,13 +225,17 @@ def G(n):
     return gtsam.symbol("g", n)
 
 
-def gm_chain_factor(g_prev, g, phi, q_var):
+def gm_chain_factor(g_prev, g, phi, q_var, cauchy_k=0.0):
     """Two consecutive time-correlated biases of one landmark's observations, a first-order
     Gauss-Markov process per axis: g - phi g_prev ~ N(0, diag(q_var)), phi = exp(-dt / tau) and
     q_var = sigma^2 (1 - phi^2), so the process keeps its variance sigma^2 and its correlation
-    exp(-|dt| / tau)."""
+    exp(-|dt| / tau). cauchy_k > 0: a Cauchy kernel of that scale on the whitened increment (a
+    drift whose steps have heavy tails: a jump -- the centroid of a landmark sliding behind
+    something -- costs little more than a large step, and the drift takes it, not the poses)."""
     phi = np.asarray(phi, float)
     noise = gtsam.noiseModel.Diagonal.Variances(np.maximum(np.asarray(q_var, float), 1e-12))
+    if cauchy_k > 0:
+        noise = gtsam.noiseModel.Robust.Create(gtsam.noiseModel.mEstimator.Cauchy.Create(cauchy_k), noise)
 
     def error(this, values, H):
         if H is not None:
@@ -424,6 +428,7 @@ class Params:
     bias_gm_tau_s: tuple = (3.0, 10.0)    # its correlation time (u, v), s
     white_scale: tuple = (1.0, 1.0)       # with the time-correlated bias: the frame's white centroid
                                    # variance (the log's less the bias's) times this (u, v)
+    bias_gm_cauchy_k: float = 0.0  # > 0: a Cauchy kernel of this scale on the drift's whitened steps
 
     def check(self):
         """The batch re-association's and the starts' constraints: ValueError naming the option
@@ -680,7 +685,8 @@ class Slam:
                                     np.maximum(gm_sig ** 2, 1e-12)))
                             else:
                                 phi = np.exp(-abs(t - prev[1]) / gm_tau)
-                                fg = gm_chain_factor(prev[0], gk, phi, gm_sig ** 2 * (1 - phi ** 2))
+                                fg = gm_chain_factor(prev[0], gk, phi, gm_sig ** 2 * (1 - phi ** 2),
+                                                     p.bias_gm_cauchy_k)
                             graph.add(fg)
                             new_f.add(fg)
                             lm_gm[j] = (gk, t)

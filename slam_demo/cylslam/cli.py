@@ -87,6 +87,7 @@ def _params(args, **over):
                bias_gm_sigma_px=tuple(getattr(args, "bias_gm", None) or (0.0, 0.0)),
                bias_gm_tau_s=tuple(getattr(args, "bias_gm_tau", None) or (3.0, 10.0)),
                white_scale=tuple(getattr(args, "white_scale", None) or (1.0, 1.0)),
+               bias_gm_cauchy_k=getattr(args, "bias_gm_cauchy", 0.0),
                calib_model=getattr(args, "calib_model", "linear"),
                max_range_rel_sigma=(None if getattr(args, "max_range_rel_sigma", None) in (None, 0)
                                     else args.max_range_rel_sigma))
@@ -433,6 +434,9 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
                         "Gauss-Markov state per observation chained along each landmark's views")
     g.add_argument("--bias-gm-tau", type=_pair, default=None, metavar="TU,TV",
                    help="its correlation times, s (u, v; default 3,10)")
+    g.add_argument("--bias-gm-cauchy", type=float, default=0.0, metavar="K",
+                   help="with --bias-gm: a Cauchy kernel of scale K on the drift's whitened steps, for "
+                        "jumps such as a landmark sliding behind something (0: none; default %(default)s)")
     g.add_argument("--white-scale", type=_pair, default=None, metavar="KU,KV",
                    help="with --bias-gm: the frame's white centroid variance times these (default 1,1)")
     g.add_argument("--fixed-cov", choices=["grid", "mean", "frame-grid", "none"], default=fixed_default,

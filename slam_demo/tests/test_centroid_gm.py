@@ -121,3 +121,20 @@ def test_a_log_without_the_bias_field_is_an_error():
     ds = read_obslog(os.path.join(os.path.dirname(__file__), "fixtures", "frontend_calib_error.jsonl"))
     with pytest.raises(ValueError, match=r"frontend_calib_error.jsonl:\d+: --bias-gm needs the observation's bias_var_px2"):
         Slam(Params(calib_states=True, covariances=False, bias_gm_sigma_px=(0.1, 0.1))).run(ds)
+
+
+def test_cauchy_chain_step_costs_the_kernel_s_loss():
+    # a step of the drift r sigma off: Gaussian cost r^2 / 2, with the Cauchy kernel of scale k
+    # k^2 / 2 log(1 + (r / k)^2) (GTSAM's Cauchy loss), so a jump of many sigmas costs little more
+    # than a large step
+    sig, phi = np.array([0.1, 0.2]), np.array([0.9, 0.5])
+    q = sig ** 2 * (1 - phi ** 2)
+    v = gtsam.Values()
+    v.insert(G(0), np.array([0.3, -0.1]))
+    step = np.array([6.0, 0.5]) * np.sqrt(q)            # 6 sigma in u, 0.5 in v
+    v.insert(G(1), phi * np.array([0.3, -0.1]) + step)
+    r2 = np.array([36.0, 0.25])
+    assert gm_chain_factor(G(0), G(1), phi, q).error(v) == pytest.approx(0.5 * r2.sum(), rel=1e-9)
+    k = 0.5
+    want = 0.5 * k * k * math.log(1 + r2.sum() / k ** 2)
+    assert gm_chain_factor(G(0), G(1), phi, q, cauchy_k=k).error(v) == pytest.approx(want, rel=1e-9)
