@@ -44,12 +44,17 @@ from cylslam.cli import FIXED_GRID  # noqa: E402  (the fixed covariance's scales
 FIXED_SCALE_TUNED = 0.5
 
 
-def run(cmd, env=None):
+def run_process(cmd, env=None):
+    """The finished process (stdout and stderr as text); a tool that fails ends the script (exit 1)."""
     p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     if p.returncode != 0:
         sys.stderr.write(" ".join(cmd) + f" failed (exit {p.returncode}):\n" + p.stderr[-2000:])
         sys.exit(1)
-    return p.stdout
+    return p
+
+
+def run(cmd, env=None):
+    return run_process(cmd, env).stdout
 
 
 def seeds_arg(s):
@@ -63,15 +68,23 @@ def seeds_arg(s):
     return out
 
 
-def drive(build, out, seed, frames, python):
-    d = os.path.join(out, f"seed{seed}")
+def render_and_detect(build, d, seed, frames):
+    """cyl-render a drive (a calibration error drawn once) into directory d and cyl detect it with
+    the defaults: (the observation log's path, the renderer's stderr, which names the true camera)."""
     os.makedirs(d, exist_ok=True)
     raw, obs = os.path.join(d, "drive.cylraw"), os.path.join(d, "observations.jsonl")
-    run([os.path.join(build, "cyl-render"), "-o", raw, "-n", str(frames), "-s", str(seed), "--calib-error", "-q"])
+    rendered = run_process([os.path.join(build, "cyl-render"), "-o", raw, "-n", str(frames), "-s", str(seed),
+                            "--calib-error", "-q"])
     run([os.path.join(build, "cyl"), "detect", raw, "--table", "calib_data/synthetic.cylt", "--calib",
          "calib_data/synthetic_camera.yaml", "--size", "orange=0.10,0.30", "--size", "green=0.10,0.30",
          "--out", obs, "--quiet"])
     os.remove(raw)
+    return obs, rendered.stderr
+
+
+def drive(build, out, seed, frames, python):
+    d = os.path.join(out, f"seed{seed}")
+    obs, _ = render_and_detect(build, d, seed, frames)
     env = dict(os.environ, PYTHONPATH="slam_demo")
     run([python, "-m", "cylslam", "run", obs, "--out", os.path.join(d, "slam"), "--calib-states", "--no-plot",
          "--no-progress"], env=env)

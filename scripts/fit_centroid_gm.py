@@ -25,7 +25,6 @@ import json
 import math
 import os
 import re
-import subprocess
 import sys
 
 import numpy as np
@@ -34,25 +33,11 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "slam_demo"))
 from cylslam.camera_model import range_bearing_model  # noqa: E402
 from cylslam.centroid_noise import Sequence, fit  # noqa: E402
+from consistency import render_and_detect, seeds_arg  # noqa: E402  (the drives consistency.py runs)
 
 TRUE_CAM = re.compile(r"true camera = calibration \+ error: fx (\S+) fy (\S+) cx (\S+) cy (\S+) px, "
                       r"tilt (\S+) yaw (\S+) deg, height (\S+) offset (\S+) m")
 GROSS_PX = 1.0
-
-
-def seeds_arg(s):
-    m = re.fullmatch(r"(\d+)(?:-(\d+))?", s)
-    if not m:
-        raise argparse.ArgumentTypeError(f"seeds: expected e.g. 1-20, got '{s}'")
-    return list(range(int(m.group(1)), int(m.group(2) or m.group(1)) + 1))
-
-
-def run(cmd):
-    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if p.returncode != 0:
-        sys.stderr.write(" ".join(cmd) + f" failed (exit {p.returncode}):\n" + p.stderr[-2000:])
-        sys.exit(1)
-    return p
 
 
 def drive(build, work, seed, frames):
@@ -64,19 +49,13 @@ def drive(build, work, seed, frames):
             c = json.load(f)
         if c.get("frames") == frames:
             return obs, c["delta"]
-    os.makedirs(d, exist_ok=True)
-    raw = os.path.join(d, "drive.cylraw")
-    p = run([os.path.join(build, "cyl-render"), "-o", raw, "-n", str(frames), "-s", str(seed), "--calib-error", "-q"])
-    m = TRUE_CAM.search(p.stderr)
+    obs, err = render_and_detect(build, d, seed, frames)
+    m = TRUE_CAM.search(err)
     if not m:
         sys.stderr.write(f"cyl-render -s {seed}: no 'true camera' line in its output\n")
         sys.exit(1)
     fx, fy, cx, cy, tilt, yaw, h, s = (float(x) for x in m.groups())
     delta = [fx, fy, cx, cy, math.radians(tilt), math.radians(yaw), h, s]
-    run([os.path.join(build, "cyl"), "detect", raw, "--table", "calib_data/synthetic.cylt", "--calib",
-         "calib_data/synthetic_camera.yaml", "--size", "orange=0.10,0.30", "--size", "green=0.10,0.30",
-         "--out", obs, "--quiet"])
-    os.remove(raw)
     with open(cal, "w") as f:
         json.dump({"frames": frames, "delta": delta}, f)
     return obs, delta

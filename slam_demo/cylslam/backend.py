@@ -111,13 +111,6 @@ def rb_jacobians(pose, lm):
     return b, r, hp, hl
 
 
-def _key_list(keys):
-    """None, one key or several: a list of keys."""
-    if keys is None:
-        return []
-    return [keys] if isinstance(keys, (int, np.integer)) else list(keys)
-
-
 def calib_factor(pose_key, lm_key, o, noise, bias_keys=()):
     """An observation with the calibration error as a state (docs/uncertainty.md, "Constant
     calibration errors"): the frontend computed z with the nominal calibration, so
@@ -129,7 +122,6 @@ def calib_factor(pose_key, lm_key, o, noise, bias_keys=()):
     (u - cx, v - cy), so a centroid moved by b reads as a principal-point error of b:
     z = h - J delta - J_cxcy b + n. bias_keys: the bias states (Vector2, px) whose sum is b (the
     landmark's constant one and the observation's time-correlated one, G)."""
-    bias_keys = _key_list(bias_keys)
     jbr = np.vstack([o.jac_calib[1], o.jac_calib[0]])   # (bearing, range) rows
     jpx = jbr[:, 2:4]                                   # d(bearing, range)/d(cx, cy)
 
@@ -169,7 +161,6 @@ def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_ke
     estimated calibration gives the pixel, not the nominal one's. The bias state enters with the
     identity (it is a pixel offset). Where the model has no range for a delta the optimiser tries (the
     ray at or above the horizon), the linearisation at the nominal calibration stands in."""
-    bias_keys = _key_list(bias_keys)
     jbr = np.vstack([o.jac_calib[1], o.jac_calib[0]])   # (bearing, range) rows, at the nominal
     a0 = -jbr[:, 2:4]                                   # d(bearing, range)/d(u, v) = -d/d(cx, cy)
     a0i = np.linalg.inv(a0)
@@ -443,6 +434,13 @@ class Params:
             raise ValueError(f"--starts {self.starts!r}: every odometry sigma scale must be > 0")
         if tuple(self.starts) != (1.0,) and not self.reassoc:
             raise ValueError("--starts needs --reassoc (the re-association scores the passes)")
+        sig, tau = np.asarray(self.bias_gm_sigma_px, float), np.asarray(self.bias_gm_tau_s, float)
+        if sig.shape != (2,) or tau.shape != (2,) or np.any(~(sig >= 0)) or np.any(~(tau > 0)):
+            raise ValueError(f"--bias-gm {tuple(sig)} / --bias-gm-tau {tuple(tau)}: two sigmas >= 0 px "
+                             "and two correlation times > 0 s")
+        if np.any(sig > 0) and (not self.calib_states or self.lm_bias == "none"):
+            raise ValueError("--bias-gm: the time-correlated bias goes with the landmark's bias state "
+                             "(--calib-states, and not --lm-bias none)")
 
 
 @dataclass
@@ -597,16 +595,11 @@ class Slam:
             raise ValueError(f"unknown landmark bias model {p.lm_bias!r}")
         lm_bias = {}                        # landmark -> its bias state's prior variance (u, v) px^2, or None
         lm_gm = {}                          # landmark -> (its latest time-correlated bias key, that step's t)
-        gm_sig = np.asarray(p.bias_gm_sigma_px, float)
+        gm_sig = np.asarray(p.bias_gm_sigma_px, float)     # (Params.check has checked them)
         gm_tau = np.asarray(p.bias_gm_tau_s, float)
-        if gm_sig.shape != (2,) or gm_tau.shape != (2,) or np.any(~(gm_sig >= 0)) or np.any(~(gm_tau > 0)):
-            raise ValueError(f"--bias-gm {tuple(gm_sig)} / --bias-gm-tau {tuple(gm_tau)}: two sigmas >= 0 px "
-                             "and two correlation times > 0 s")
-        use_gm = bool(np.any(gm_sig > 0))
-        if use_gm and (not p.calib_states or p.lm_bias == "none"):
-            raise ValueError("--bias-gm: the time-correlated bias goes with the landmark's bias state "
-                             "(--calib-states, and not --lm-bias none)")
-        use_gm = use_gm and use_calib       # the fixed-covariance runs replace the whole covariance
+        white_scale = np.asarray(p.white_scale, float)
+        # the fixed-covariance runs replace the whole covariance: no drift states there
+        use_gm = bool(np.any(gm_sig > 0)) and use_calib
         cur = start.copy()                  # current estimate of the newest pose
         lms_init = []                       # initial/latest estimate per landmark
         lm_class, lm_ids = [], []
@@ -661,7 +654,7 @@ class Slam:
                         # the rest is the frame's white noise and the time-correlated bias: the
                         # white part, scaled, stays here; the other is the G state's
                         ji = np.linalg.inv(jpx)
-                        var_px = np.maximum(np.diag(ji @ cf @ ji.T), 1e-8) * np.asarray(p.white_scale, float)
+                        var_px = np.maximum(np.diag(ji @ cf @ ji.T), 1e-8) * white_scale
                         cf = jpx @ np.diag(var_px) @ jpx.T
                 if p.fixed_frame_cov is not None:
                     cf = p.fixed_frame_cov

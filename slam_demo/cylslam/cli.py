@@ -84,10 +84,10 @@ def _params(args, **over):
                reassoc=getattr(args, "reassoc", 0), starts=tuple(getattr(args, "starts", None) or (1.0,)),
                calib_states=getattr(args, "calib_states", False),
                lm_bias=getattr(args, "lm_bias", "auto"),
-               bias_gm_sigma_px=tuple(getattr(args, "bias_gm", None) or (0.0, 0.0)),
-               bias_gm_tau_s=tuple(getattr(args, "bias_gm_tau", None) or (3.0, 10.0)),
-               white_scale=tuple(getattr(args, "white_scale", None) or (1.0, 1.0)),
-               bias_gm_cauchy_k=getattr(args, "bias_gm_cauchy", 0.0),
+               bias_gm_sigma_px=tuple(getattr(args, "bias_gm", None) or Params.bias_gm_sigma_px),
+               bias_gm_tau_s=tuple(getattr(args, "bias_gm_tau", None) or Params.bias_gm_tau_s),
+               white_scale=tuple(getattr(args, "white_scale", None) or Params.white_scale),
+               bias_gm_cauchy_k=getattr(args, "bias_gm_cauchy", Params.bias_gm_cauchy_k),
                calib_model=getattr(args, "calib_model", "linear"),
                max_range_rel_sigma=(None if getattr(args, "max_range_rel_sigma", None) in (None, 0)
                                     else args.max_range_rel_sigma))

@@ -30,7 +30,7 @@ def test_bias_factor_residual_and_jacobian():
     o = Obs(cls="orange", range_m=z[0], bearing_rad=z[1], cov=np.eye(2), jac_calib=_jac(),
             cov_frame=np.diag([1e-4, 1e-6]))
     noise = gtsam.noiseModel.Gaussian.Covariance(np.diag([1e-6, 1e-4]))
-    f = calib_factor(X(0), L(0), o, noise, B(0))
+    f = calib_factor(X(0), L(0), o, noise, [B(0)])
 
     def values(bv):
         v = gtsam.Values()
