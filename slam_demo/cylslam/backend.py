@@ -43,7 +43,7 @@ import gtsam
 import numpy as np
 
 from .camera_model import range_bearing_model
-from .data import FLAG_NO_RANGE, FLAGS_REJECT, compose, rb_to_world, wrap
+from .data import FLAG_NO_RANGE, FLAG_NONLINEAR, FLAGS_REJECT, compose, rb_to_world, wrap
 
 PERM = np.array([[0.0, 1.0], [1.0, 0.0]])
 ROBUST_KERNELS = {"huber": gtsam.noiseModel.mEstimator.Huber, "cauchy": gtsam.noiseModel.mEstimator.Cauchy}
@@ -111,7 +111,7 @@ def rb_jacobians(pose, lm):
     return b, r, hp, hl
 
 
-def calib_factor(pose_key, lm_key, o, noise, bias_keys=()):
+def calib_factor(pose_key, lm_key, o, noise, bias_keys=(), bearing_only=False):
     """An observation with the calibration error as a state (docs/uncertainty.md, "Constant
     calibration errors"): the frontend computed z with the nominal calibration, so
     z = h(pose, lm) - J delta + n, with delta = true - nominal calibration, J = o.jac_calib and
@@ -121,9 +121,11 @@ def calib_factor(pose_key, lm_key, o, noise, bias_keys=()):
     Params.lm_bias) is a state too: range and bearing depend on the centroid through
     (u - cx, v - cy), so a centroid moved by b reads as a principal-point error of b:
     z = h - J delta - J_cxcy b + n. bias_keys: the bias states (Vector2, px) whose sum is b (the
-    landmark's constant one and the observation's time-correlated one, G)."""
+    landmark's constant one and the observation's time-correlated one, G).
+    bearing_only: the bearing row alone (noise then 1-D: the bearing's variance)."""
     jbr = np.vstack([o.jac_calib[1], o.jac_calib[0]])   # (bearing, range) rows
     jpx = jbr[:, 2:4]                                   # d(bearing, range)/d(cx, cy)
+    rows = slice(0, 1) if bearing_only else slice(0, 2)
 
     def error(this, values, H):
         p = values.atPose2(pose_key)
@@ -135,18 +137,18 @@ def calib_factor(pose_key, lm_key, o, noise, bias_keys=()):
             e = e - jpx @ values.atVector(bk)
         e[0] = (e[0] + np.pi) % (2 * np.pi) - np.pi
         if H is not None:
-            H[0] = hp
-            H[1] = hl
-            H[2] = -jbr
+            H[0] = hp[rows]
+            H[1] = hl[rows]
+            H[2] = -jbr[rows]
             for n in range(len(bias_keys)):
-                H[3 + n] = -jpx
-        return e
+                H[3 + n] = -jpx[rows]
+        return e[rows]
 
     keys = [pose_key, lm_key, CALIB] + list(bias_keys)
     return gtsam.CustomFactor(noise, keys, error)
 
 
-def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_keys=()):
+def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_keys=(), bearing_only=False):
     """As calib_factor, with libcyl's camera model evaluated at the estimated calibration instead of
     its linearisation at the nominal one (rbm: camera_model.range_bearing_model). The predicted
     measurement is m(delta, b) = cyl_rb_eval(u - du, v - dv, nominal + delta), so z = h(pose, lm) + n
@@ -160,13 +162,16 @@ def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_ke
     covariance, with the frontend's distortion terms). So the range's noise grows with the range the
     estimated calibration gives the pixel, not the nominal one's. The bias state enters with the
     identity (it is a pixel offset). Where the model has no range for a delta the optimiser tries (the
-    ray at or above the horizon), the linearisation at the nominal calibration stands in."""
+    ray at or above the horizon), the linearisation at the nominal calibration stands in.
+    bearing_only: the residual's column (u) alone, with the centroid's u variance: a far
+    observation's row (v) carries its range, which is far from linear there and drifts."""
     jbr = np.vstack([o.jac_calib[1], o.jac_calib[0]])   # (bearing, range) rows, at the nominal
     a0 = -jbr[:, 2:4]                                   # d(bearing, range)/d(u, v) = -d/d(cx, cy)
     a0i = np.linalg.inv(a0)
     cov_px = a0i @ to_gtsam_cov(cov_frame) @ a0i.T
     cov_px = 0.5 * (cov_px + cov_px.T)
-    noise = gtsam.noiseModel.Gaussian.Covariance(cov_px)
+    rows = slice(0, 1) if bearing_only else slice(0, 2)
+    noise = gtsam.noiseModel.Gaussian.Covariance(cov_px[rows, rows])
     if robust is not None:
         noise = gtsam.noiseModel.Robust.Create(robust, noise)
     z = np.array([o.bearing_rad, o.range_m])
@@ -190,13 +195,13 @@ def calib_factor_exact(pose_key, lm_key, o, cov_frame, rbm, robust=None, bias_ke
             zhat = z + jd @ d - a @ bb
         e = np.array([b, r]) - zhat
         e[0] = wrap(e[0])
-        ai = np.linalg.inv(a)
+        ai = np.linalg.inv(a)[rows]
         if H is not None:
             H[0] = ai @ hp
             H[1] = ai @ hl
             H[2] = -ai @ jd
             for n in range(len(bias_keys)):
-                H[3 + n] = np.eye(2)                     # zhat(u - b): d e / d b = A^-1 A (A^-1 held, Gauss-Newton)
+                H[3 + n] = np.eye(2)[rows]               # zhat(u - b): d e / d b = A^-1 A (A^-1 held, Gauss-Newton)
         return ai @ e
 
     keys = [pose_key, lm_key, CALIB] + list(bias_keys)
@@ -420,6 +425,11 @@ class Params:
     white_scale: tuple = (1.0, 1.0)       # with the time-correlated bias: the frame's white centroid
                                    # variance (the log's less the bias's) times this (u, v)
     bias_gm_cauchy_k: float = 0.0  # > 0: a Cauchy kernel of this scale on the drift's whitened steps
+    far_bearing: bool = False      # an observation dropped only for the frontend's non-linear flag
+                                   # (0x400) or max_range_rel_sigma is kept for its bearing alone (the
+                                   # image column with calibration states); it starts no landmark
+    far_bearing_var_scale: float = 1.0  # with calibration states, that bearing's variance (the
+                                   # frame's) times this; the fixed-covariance runs keep theirs
 
     def check(self):
         """The batch re-association's and the starts' constraints: ValueError naming the option
@@ -438,6 +448,8 @@ class Params:
         if sig.shape != (2,) or tau.shape != (2,) or np.any(~(sig >= 0)) or np.any(~(tau > 0)):
             raise ValueError(f"--bias-gm {tuple(sig)} / --bias-gm-tau {tuple(tau)}: two sigmas >= 0 px "
                              "and two correlation times > 0 s")
+        if not (self.far_bearing_var_scale > 0):
+            raise ValueError(f"--far-bearing-scale {self.far_bearing_var_scale}: must be > 0")
         if np.any(sig > 0) and (not self.calib_states or self.lm_bias == "none"):
             raise ValueError("--bias-gm: the time-correlated bias goes with the landmark's bias state "
                              "(--calib-states, and not --lm-bias none)")
@@ -460,16 +472,24 @@ class Result:
 
 def drop_reason(o, p):
     """Why an observation is not used ("dropped_flags", "dropped_no_range", "dropped_confidence",
-    "dropped_far"), or None: the one rule for every run."""
-    if o.flags & p.reject_flags:
+    "dropped_far"), or None: the one rule for every run. With p.far_bearing an observation dropped
+    only as far (bearing_only) is used."""
+    if o.flags & p.reject_flags & ~(FLAG_NONLINEAR if p.far_bearing else 0):
         return "dropped_flags"
     if (o.flags & FLAG_NO_RANGE) or o.range_m <= 0:
         return "dropped_no_range"
     if o.confidence < p.conf_min:
         return "dropped_confidence"
-    if p.max_range_rel_sigma is not None and math.sqrt(max(o.cov[0, 0], 0.0)) > p.max_range_rel_sigma * o.range_m:
+    if not p.far_bearing and is_far(o, p):
         return "dropped_far"
     return None
+
+
+def is_far(o, p):
+    """The observation's range is too far from linear to use: the frontend's non-linear flag when
+    the run rejects it, or a range sigma beyond p.max_range_rel_sigma of the range."""
+    return bool(o.flags & p.reject_flags & FLAG_NONLINEAR) or (
+        p.max_range_rel_sigma is not None and math.sqrt(max(o.cov[0, 0], 0.0)) > p.max_range_rel_sigma * o.range_m)
 
 
 class Slam:
@@ -494,6 +514,12 @@ class Slam:
 
     def _obs_noise(self, cov_rb):
         g = gtsam.noiseModel.Gaussian.Covariance(to_gtsam_cov(cov_rb))
+        k = self._robust()
+        return g if k is None else gtsam.noiseModel.Robust.Create(k, g)
+
+    def _bearing_noise(self, cov_rb):
+        """A bearing-only factor's noise: the bearing's variance (cov_rb in (range, bearing) order)."""
+        g = gtsam.noiseModel.Isotropic.Sigma(1, math.sqrt(max(cov_rb[1, 1], 1e-18)))
         k = self._robust()
         return g if k is None else gtsam.noiseModel.Robust.Create(k, g)
 
@@ -608,7 +634,8 @@ class Slam:
         assoc = []
         st = dict(obs_total=0, dropped_flags=0, dropped_no_range=0, dropped_confidence=0, dropped_far=0,
                   dropped_ambiguous=0, dropped_imprecise=0, used=0, new_landmarks=0, isam_updates=0,
-                  marginal_calls=0, new_by_exclusion=0, dropped_unconfirmed=0, association=mode, by_identity=0, bias_states=0, exact_factors=0, gm_states=0)
+                  marginal_calls=0, new_by_exclusion=0, dropped_unconfirmed=0, association=mode, by_identity=0, bias_states=0, exact_factors=0, gm_states=0,
+                  bearing_only=0, dropped_far_new=0)
         last_update = 0
         merged_into = {}                    # landmark -> the landmark it was merged into
         co_seen = set()                     # (j, k), j < k: landmarks observed in one frame
@@ -641,6 +668,7 @@ class Slam:
             return j
 
         def add_observation(k, o, c, j):
+            far = p.far_bearing and is_far(o, p)
             if use_calib:
                 if o.jac_calib is None:
                     raise ValueError(f"{o.where}: calibration states need jac_calib and cov_frame")
@@ -687,13 +715,21 @@ class Slam:
                 if rbm is not None:
                     if o.u_px is None:
                         raise ValueError(f"{o.where}: --calib-model exact needs the observation's u_px, v_px")
-                    f = calib_factor_exact(X(k), L(j), o, cf, rbm, self._robust(), bk)
+                    if far and p.fixed_frame_cov is None:
+                        cf = cf * p.far_bearing_var_scale
+                    f = calib_factor_exact(X(k), L(j), o, cf, rbm, self._robust(), bk, bearing_only=far)
                     st["exact_factors"] += 1
                 else:
-                    f = calib_factor(X(k), L(j), o, self._obs_noise(cf), bk)
+                    sc = p.far_bearing_var_scale if p.fixed_frame_cov is None else 1.0
+                    noise = self._bearing_noise(cf * sc) if far else self._obs_noise(cf)
+                    f = calib_factor(X(k), L(j), o, noise, bk, bearing_only=far)
+            elif far:
+                f = gtsam.BearingFactor2D(X(k), L(j), gtsam.Rot2(o.bearing_rad), self._bearing_noise(c))
             else:
                 f = gtsam.BearingRangeFactor2D(X(k), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
                                                self._obs_noise(c))
+            if far:
+                st["bearing_only"] += 1
             graph.add(f)
             new_f.add(f)
             assoc.append((k, o, j))
@@ -798,13 +834,16 @@ class Slam:
                     continue
                 if mode == "known" or (mode == "mixed" and o.lm_id is not None):
                     j = id_to_lm.get(o.lm_id, -1)   # may have been created earlier this frame
-                elif j == -1 and p.init_views > 1:
+                elif j == -1 and p.init_views > 1 and not (p.far_bearing and is_far(o, p)):
                     cand = pending.add(i, cur, o, c)
                     if cand is None:
                         continue                    # waits in the candidate buffer
                     j = new_landmark(o, pending.mean(cand)[0])
                     for (k, ok, ck) in cand["views"]:
                         add_observation(k, ok, ck, j)
+                    continue
+                if j == -1 and p.far_bearing and is_far(o, p):
+                    st["dropped_far_new"] += 1      # a bearing alone starts no landmark
                     continue
                 if j == -1:
                     j = new_landmark(o, rb_to_world(cur, o.range_m, o.bearing_rad))

@@ -89,6 +89,8 @@ def _params(args, **over):
                white_scale=tuple(getattr(args, "white_scale", None) or Params.white_scale),
                bias_gm_cauchy_k=getattr(args, "bias_gm_cauchy", Params.bias_gm_cauchy_k),
                calib_model=getattr(args, "calib_model", "linear"),
+               far_bearing=getattr(args, "far_bearing", False),
+               far_bearing_var_scale=getattr(args, "far_bearing_scale", Params.far_bearing_var_scale),
                max_range_rel_sigma=(None if getattr(args, "max_range_rel_sigma", None) in (None, 0)
                                     else args.max_range_rel_sigma))
     for k, v in over.items():
@@ -119,18 +121,28 @@ def _r(v, n=4):
     return v
 
 
-def mean_obs_cov(res):
-    return np.mean([o.cov for (_, o, _) in res.assoc], axis=0)
+def _used_whole(res, p):
+    """The main run's observations used for range and bearing (not those kept for their bearing
+    alone, whose range variance is not used: --far-bearing); all of them if none is."""
+    from .backend import is_far
+    whole = [o for (_, o, _) in res.assoc if not (p.far_bearing and is_far(o, p))]
+    return whole or [o for (_, o, _) in res.assoc]
+
+
+def mean_obs_cov(res, p):
+    """The mean of the main run's observation covariances (of those it used whole)."""
+    return np.mean([o.cov for o in _used_whole(res, p)], axis=0)
 
 
 def mean_frame_cov(res, p):
     """The mean of the frame covariances the main run's factors used (less the part a landmark's
-    bias state carries), or None when it had no calibration states."""
-    if not p.calib_states or any(o.cov_frame is None for (_, o, _) in res.assoc):
+    bias state carries; of the observations used whole), or None when it had no calibration states."""
+    obs = _used_whole(res, p)
+    if not p.calib_states or any(o.cov_frame is None for o in obs):
         return None
     return np.mean([o.cov_frame - (o.jac_calib[:, 2:4] @ np.diag(o.bias_var_px2) @ o.jac_calib[:, 2:4].T
                                    if o.bias_var_px2 is not None and p.lm_bias != "none" else 0.0)
-                    for (_, o, _) in res.assoc], axis=0)
+                    for o in obs], axis=0)
 
 
 def process(ds, args, label, outdir):
@@ -171,7 +183,7 @@ def process(ds, args, label, outdir):
             raise ValueError("--fixed-cov frame-grid needs --calib-states and frame covariances in the log")
         key_cov = "fixed_frame_cov" if mean is not None else "fixed_cov"
         if mean is None:
-            mean = mean_obs_cov(res)
+            mean = mean_obs_cov(res, _params(args))
         scales = FIXED_GRID if (args.fixed_cov in ("grid", "frame-grid") and has_truth) else (1.0,)
         best = None
         why = []
@@ -352,7 +364,8 @@ def last_line(s, extra=None):
 
 
 def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="grid",
-               max_range_rel_sigma_default=0.0, reject_default="0x320"):
+               max_range_rel_sigma_default=0.0, reject_default="0x320", far_bearing_default=False,
+               far_bearing_scale_default=1.0):
     g = sp.add_argument_group("back end")
     g.add_argument("--assoc", choices=["auto", "known", "unknown", "mixed"], default=assoc_default,
                    help="data association: known identities, unknown (Mahalanobis gating), mixed "
@@ -413,6 +426,14 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
                         "from the camera the range varies as 1/tan of the depression and its "
                         "distribution, and a calibration error's effect, are far from linear "
                         "(0 = keep all; default %(default)s)")
+    g.add_argument("--far-bearing", action=argparse.BooleanOptionalAction, default=far_bearing_default,
+                   help="keep an observation dropped only as far (the non-linear flag 0x400 among "
+                        "--reject-flags, or --max-range-rel-sigma) for its bearing alone: with "
+                        "--calib-states its image column; it starts no landmark (default: %s)"
+                        % ("on" if far_bearing_default else "off"))
+    g.add_argument("--far-bearing-scale", type=float, default=far_bearing_scale_default, metavar="S",
+                   help="with --far-bearing and --calib-states: that bearing's variance (the "
+                        "frame's) times S (default %(default)s)")
     g.add_argument("--calib-states", action="store_true",
                    help="estimate the camera calibration's error (fx fy cx cy tilt yaw h s) as one "
                         "state for the run: each observation's factor uses its frame covariance and "
@@ -831,7 +852,9 @@ def build_parser():
     # 0x400: observations the frontend flags non-linear are dropped. Chosen on the synthetic drive's
     # tuning seeds 1-20 (landmark ANEES inside its 95% bounds on 16 of 20, against 9 keeping them;
     # docs/uncertainty.md); the same rule as --max-range-rel-sigma 0.055.
-    add_common(sp, reject_default="0x720")
+    # --far-bearing and its scale 0.8: chosen on the same tuning seeds (scales 0.4-1; 0.8 put the
+    # pose ANEES inside on 19 of 20, against 17 at 1 and 15 at 0.6; docs/uncertainty.md)
+    add_common(sp, reject_default="0x720", far_bearing_default=True, far_bearing_scale_default=0.8)
     sp.set_defaults(func=cmd_run)
 
     sp = sub.add_parser("synth", help="write a synthetic observation log with ground truth",
