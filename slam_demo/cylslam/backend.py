@@ -517,6 +517,13 @@ class Slam:
         k = self._robust()
         return g if k is None else gtsam.noiseModel.Robust.Create(k, g)
 
+    def _plain_factor(self, k, j, o, c):
+        """An observation's factor without calibration states, covariance c (range, bearing):
+        range and bearing, or the bearing alone for a far one (Params.far_bearing)."""
+        if self.p.far_bearing and is_far(o, self.p):
+            return gtsam.BearingFactor2D(X(k), L(j), gtsam.Rot2(o.bearing_rad), self._bearing_noise(c))
+        return gtsam.BearingRangeFactor2D(X(k), L(j), gtsam.Rot2(o.bearing_rad), o.range_m, self._obs_noise(c))
+
     def _bearing_noise(self, cov_rb):
         """A bearing-only factor's noise: the bearing's variance (cov_rb in (range, bearing) order)."""
         g = gtsam.noiseModel.Isotropic.Sigma(1, math.sqrt(max(cov_rb[1, 1], 1e-18)))
@@ -723,11 +730,8 @@ class Slam:
                     sc = p.far_bearing_var_scale if p.fixed_frame_cov is None else 1.0
                     noise = self._bearing_noise(cf * sc) if far else self._obs_noise(cf)
                     f = calib_factor(X(k), L(j), o, noise, bk, bearing_only=far)
-            elif far:
-                f = gtsam.BearingFactor2D(X(k), L(j), gtsam.Rot2(o.bearing_rad), self._bearing_noise(c))
             else:
-                f = gtsam.BearingRangeFactor2D(X(k), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
-                                               self._obs_noise(c))
+                f = self._plain_factor(k, j, o, c)
             if far:
                 st["bearing_only"] += 1
             graph.add(f)
@@ -912,16 +916,15 @@ class Slam:
                       info=info, lm_keys=lm_keys)
 
     def _solve_pairings(self, base_f, est, pairs, states=()):
-        """The graph of `base_f` and one range-bearing factor per (step, observation, covariance,
-        landmark) of `pairs`, solved by Levenberg-Marquardt from `est` (poses, and the landmarks
+        """The graph of `base_f` and one range-bearing factor (bearing for a far one) per (step,
+        observation, covariance, landmark) of `pairs`, solved by Levenberg-Marquardt from `est` (poses, and the landmarks
         the pairs name) and, when `base_f` holds odometry states, their (key, initial value) pairs
         `states`: (graph, estimate)."""
         graph = gtsam.NonlinearFactorGraph()
         for f in base_f:
             graph.add(f)
         for (i, o, c, j) in pairs:
-            graph.add(gtsam.BearingRangeFactor2D(X(i), L(j), gtsam.Rot2(o.bearing_rad), o.range_m,
-                                                 self._obs_noise(c)))
+            graph.add(self._plain_factor(i, j, o, c))
         used = {j for (_, _, _, j) in pairs}
         v = gtsam.Values()
         for key in est.keys():

@@ -117,8 +117,7 @@ def run_multi(datasets, labels, params, progress=None) -> MultiResult:
                 # has no estimate, and its observations stay out too
                 if drop_reason(o, params) or o.lm_id is None or o.lm_id not in ref:
                     continue
-                graph.add(gtsam.BearingRangeFactor2D(X(base + i), L(o.lm_id), gtsam.Rot2(o.bearing_rad),
-                                                     o.range_m, slam._obs_noise(o.cov)))
+                graph.add(slam._plain_factor(base + i, o.lm_id, o, o.cov))
                 n_obs += 1
     for i, p in ref.items():
         values.insert(L(i), gtsam.Point2(*p))

@@ -174,3 +174,27 @@ def test_command_line():
                         "--far-bearing-scale", "0"], capture_output=True, text=True,
                        env=dict(os.environ, PYTHONPATH=here), timeout=120)
     assert r.returncode == 2 and "--far-bearing-scale 0.0: must be > 0" in r.stderr
+
+
+def test_batch_reassociation_keeps_far_bearings():
+    """Unknown association with batch re-association rebuilds the graph from its pairings: a far
+    observation stays a bearing there (_plain_factor), so its long range does not reach the map --
+    the landmark is where the online pass (bearings too) puts it, not where the ranges used whole do."""
+    from dataclasses import replace
+    err = {}
+    for name, reject, far_bearing, reassoc in (("bearing", 0x720, True, 2), ("online", 0x720, True, 0),
+                                               ("whole", 0x320, False, 2)):
+        e = []
+        for run in range(3):
+            ds = _drive(np.random.default_rng(100 + run), far_bias=1.1)
+            ds.known_ids = False
+            for s in ds.steps:
+                s.obs = [replace(o, lm_id=None) for o in s.obs]
+            res = Slam(Params(reject_flags=reject, far_bearing=far_bearing, assoc="unknown", reassoc=reassoc,
+                              covariances=False)).run(ds)
+            e.append(np.min(np.linalg.norm(np.asarray(res.lms) - [6.0, 5.0], axis=1)))
+            if far_bearing:
+                assert res.stats["bearing_only"] > 50
+        err[name] = np.median(e)
+    assert err["bearing"] < 0.08 and err["online"] < 0.08
+    assert err["whole"] > 0.15
