@@ -430,6 +430,10 @@ class Params:
                                    # image column with calibration states); it starts no landmark
     far_bearing_var_scale: float = 1.0  # with calibration states, that bearing's variance (the
                                    # frame's) times this; the fixed-covariance runs keep theirs
+    far_bearing_every_s: float = 0.0  # > 0: of one landmark's far bearings, one at most every this
+                                   # many seconds (consecutive views repeat the centroid's drift,
+                                   # and hundreds of them turn a small error of their variance
+                                   # into an over-confident trajectory); the others are dropped
 
     def check(self):
         """The batch re-association's and the starts' constraints: ValueError naming the option
@@ -450,6 +454,8 @@ class Params:
                              "and two correlation times > 0 s")
         if not (self.far_bearing_var_scale > 0):
             raise ValueError(f"--far-bearing-scale {self.far_bearing_var_scale}: must be > 0")
+        if not (self.far_bearing_every_s >= 0):
+            raise ValueError(f"--far-bearing-every {self.far_bearing_every_s}: must be >= 0 s")
         if np.any(sig > 0) and (not self.calib_states or self.lm_bias == "none"):
             raise ValueError("--bias-gm: the time-correlated bias goes with the landmark's bias state "
                              "(--calib-states, and not --lm-bias none)")
@@ -642,7 +648,7 @@ class Slam:
         st = dict(obs_total=0, dropped_flags=0, dropped_no_range=0, dropped_confidence=0, dropped_far=0,
                   dropped_ambiguous=0, dropped_imprecise=0, used=0, new_landmarks=0, isam_updates=0,
                   marginal_calls=0, new_by_exclusion=0, dropped_unconfirmed=0, association=mode, by_identity=0, bias_states=0, exact_factors=0, gm_states=0,
-                  bearing_only=0, dropped_far_new=0)
+                  bearing_only=0, dropped_far_new=0, dropped_far_decimated=0)
         last_update = 0
         merged_into = {}                    # landmark -> the landmark it was merged into
         co_seen = set()                     # (j, k), j < k: landmarks observed in one frame
@@ -674,8 +680,16 @@ class Slam:
             st["new_landmarks"] += 1
             return j
 
+        far_last = {}                       # landmark -> the time of its last far bearing used
+
         def add_observation(k, o, c, j):
             far = p.far_bearing and is_far(o, p)
+            if far and p.far_bearing_every_s > 0:
+                t = steps[k].t
+                if j in far_last and t - far_last[j] < p.far_bearing_every_s:
+                    st["dropped_far_decimated"] += 1
+                    return
+                far_last[j] = t
             if use_calib:
                 if o.jac_calib is None:
                     raise ValueError(f"{o.where}: calibration states need jac_calib and cov_frame")

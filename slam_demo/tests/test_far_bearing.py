@@ -159,15 +159,15 @@ def test_fixed_baseline_is_the_mean_of_the_whole_observations():
 
 
 def test_command_line():
-    """cylslam run: on by default with the scale the tuning drives chose; --no-far-bearing turns it
-    off; a scale <= 0 is a usage error (exit 2) naming the option."""
+    """cylslam run: on by default, one bearing a landmark every 0.5 s (what the tuning drives chose);
+    --no-far-bearing turns it off; a scale <= 0 is a usage error (exit 2) naming the option."""
     import os
     import subprocess
     import sys
     from cylslam.cli import _params, build_parser
     a = build_parser().parse_args(["run", "x.jsonl"])
     p = _params(a)
-    assert p.far_bearing and p.far_bearing_var_scale == 0.8
+    assert p.far_bearing and p.far_bearing_var_scale == 1.0 and p.far_bearing_every_s == 0.5
     assert not _params(build_parser().parse_args(["run", "x.jsonl", "--no-far-bearing"])).far_bearing
     here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     r = subprocess.run([sys.executable, "-m", "cylslam", "run", os.path.join(here, "tests", "fixtures", "synth_short.jsonl"),
@@ -198,3 +198,17 @@ def test_batch_reassociation_keeps_far_bearings():
         err[name] = np.median(e)
     assert err["bearing"] < 0.08 and err["online"] < 0.08
     assert err["whole"] > 0.15
+
+
+def test_one_far_bearing_a_landmark_every_interval():
+    """far_bearing_every_s: of one landmark's far views (every 0.1 s here) one at most every
+    interval is used, counted as dropped_far_decimated; near views are never thinned."""
+    ds = _drive(np.random.default_rng(3))
+    n_far = 119                                    # landmark 3's flagged views, steps 1-119
+    for every, kept in ((0.0, n_far), (0.5, 24), (1.0, 12)):
+        res = Slam(Params(reject_flags=0x720, far_bearing=True, far_bearing_every_s=every, covariances=False)).run(ds)
+        assert res.stats["bearing_only"] == kept
+        assert res.stats["dropped_far_decimated"] == n_far - kept
+        assert sum(1 for (_, o, _) in res.assoc if not o.flags) == 3 * 120 + 1   # every near view
+    with pytest.raises(ValueError, match="--far-bearing-every -1.0: must be >= 0 s"):
+        Params(far_bearing_every_s=-1.0).check()
