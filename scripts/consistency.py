@@ -15,10 +15,13 @@ measured one, cyl-synth-validate --sweep-only) and the pixel-noise-only NEES. Wr
 ANEES per seed with its bounds. The last line is one JSON object.
 
 Usage: scripts/consistency.py [--quick] [--seeds 101-120] [--frames N] [--out DIR] [--build DIR]
-                              [--drives-only] [--fixed-scale S]
+                              [--drives-only] [--fixed-scale S] [--noise-scale K]
   --quick        seeds 101-102 at 300 frames and the sweep's reduced sizes (what make test runs)
   --drives-only  the SLAM drives alone (the tuning run: --seeds 1-20 --drives-only)
   --fixed-scale  the single fixed covariance compared with (default: the one the tuning seeds chose)
+  --noise-scale  render the drives with the scene's sensor noise (noise_y, noise_c) times K: the
+                 built-in scene written out (cyl-render --write-scene), scaled, and rendered from
+                 that file (default 1: the built-in scene itself)
 Exit codes: 0 ran (whatever the figures), 1 a tool failed, 2 bad command line.
 """
 import argparse
@@ -70,13 +73,36 @@ def seeds_arg(s):
     return out
 
 
-def render_and_detect(build, d, seed, frames):
-    """cyl-render a drive (a calibration error drawn once) into directory d and cyl detect it with
-    the defaults: (the observation log's path, the renderer's stderr, which names the true camera)."""
+def noisy_scene(build, out, k):
+    """The built-in scene with its sensor noise (noise_y, noise_c) times k, as a scene file in out."""
+    base = os.path.join(out, "scene_builtin.yaml")
+    run_process([os.path.join(build, "cyl-render"), "--write-scene", base, "-q"])
+    with open(base) as f:
+        text = f.read()
+    n = 0
+
+    def scale(m):
+        nonlocal n
+        n += 1
+        return f"{m.group(1)}{float(m.group(2)) * k!r}"
+    text = re.sub(r"^(\s*noise_[yc]:\s*)(\S+)\s*$", scale, text, flags=re.M)
+    if n != 2:
+        sys.stderr.write(f"{base}: expected the keys noise_y and noise_c once each, found {n}\n")
+        sys.exit(1)
+    path = os.path.join(out, f"scene_noise_x{k:g}.yaml")
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+def render_and_detect(build, d, seed, frames, scene=None):
+    """cyl-render a drive (a calibration error drawn once; the built-in scene, or a scene file)
+    into directory d and cyl detect it with the defaults: (the observation log's path, the
+    renderer's stderr, which names the true camera)."""
     os.makedirs(d, exist_ok=True)
     raw, obs = os.path.join(d, "drive.cylraw"), os.path.join(d, "observations.jsonl")
     rendered = run_process([os.path.join(build, "cyl-render"), "-o", raw, "-n", str(frames), "-s", str(seed),
-                            "--calib-error", "-q"])
+                            "--calib-error", "-q"] + (["-S", scene] if scene else []))
     run([os.path.join(build, "cyl"), "detect", raw, "--table", "calib_data/synthetic.cylt", "--calib",
          "calib_data/synthetic_camera.yaml", "--size", "orange=0.10,0.30", "--size", "green=0.10,0.30",
          "--out", obs, "--quiet"])
@@ -84,9 +110,9 @@ def render_and_detect(build, d, seed, frames):
     return obs, rendered.stderr
 
 
-def drive(build, out, seed, frames, python):
+def drive(build, out, seed, frames, python, scene=None):
     d = os.path.join(out, f"seed{seed}")
-    obs, _ = render_and_detect(build, d, seed, frames)
+    obs, _ = render_and_detect(build, d, seed, frames, scene)
     env = dict(os.environ, PYTHONPATH="slam_demo")
     run([python, "-m", "cylslam", "run", obs, "--out", os.path.join(d, "slam"), "--calib-states", "--no-plot",
          "--no-progress"], env=env)
@@ -138,18 +164,23 @@ def main():
     ap.add_argument("--fixed-scale", type=float, choices=FIXED_GRID, default=FIXED_SCALE_TUNED,
                     help="the fixed covariance judged against, as a scale of the mean per-observation "
                          "covariance (default: the one chosen on the tuning seeds 1-20)")
+    ap.add_argument("--noise-scale", type=float, default=1.0,
+                    help="the scene's sensor noise times K for the drives (default 1: the built-in scene)")
     a = ap.parse_args()
+    if not a.noise_scale > 0:
+        ap.error(f"--noise-scale {a.noise_scale}: must be > 0")
     seeds = a.seeds or ([101, 102] if a.quick else list(range(101, 121)))
     frames = a.frames or (300 if a.quick else 1000)
     out = a.out or os.path.join(a.build, "consistency" + ("-quick" if a.quick else ""))
     os.makedirs(out, exist_ok=True)
     t0 = time.time()
+    scene = noisy_scene(a.build, out, a.noise_scale) if a.noise_scale != 1.0 else None
     rows = []
     print("joint ANEES (judged) and the mean of the marginal NEES (marg.)")
     print(f"{'seed':>5} {'lm ANEES':>9} {'(marg.)':>8} {'bounds':>11} {'pose ANEES':>10} {'(marg.)':>8} {'bounds':>11} "
           f"{'ATE m':>8} {'fixed m':>8} {'dead-r m':>8} {'assoc':>5} {'mapped':>7}")
     for i, seed in enumerate(seeds):
-        s = drive(a.build, out, seed, frames, a.python)
+        s = drive(a.build, out, seed, frames, a.python, scene)
         r = {"seed": seed, "anees_landmarks": s.get("anees_landmarks_joint"),
              "anees_landmarks_bounds95": s.get("anees_landmarks_joint_bounds95"),
              "anees_poses": s.get("anees_poses_joint"), "anees_poses_bounds95": s.get("anees_poses_joint_bounds95"),
@@ -199,7 +230,7 @@ def main():
           f"(marginal means: {lm_in_m} and {pose_in_m}); ATE better than the best fixed covariance on {better} of {n}")
 
     res = {
-        "seeds": seeds, "frames": frames,
+        "seeds": seeds, "frames": frames, "noise_scale": a.noise_scale,
         "seeds_landmark_anees_in_bounds": round(lm_in / n, 3),
         "seeds_pose_anees_in_bounds": round(pose_in / n, 3),
         "seeds_landmark_anees_marginal_in_bounds": round(lm_in_m / n, 3),
