@@ -79,13 +79,8 @@ def noisy_scene(build, out, k):
     run_process([os.path.join(build, "cyl-render"), "--write-scene", base, "-q"])
     with open(base) as f:
         text = f.read()
-    n = 0
-
-    def scale(m):
-        nonlocal n
-        n += 1
-        return f"{m.group(1)}{float(m.group(2)) * k!r}"
-    text = re.sub(r"^(\s*noise_[yc]:\s*)(\S+)\s*$", scale, text, flags=re.M)
+    text, n = re.subn(r"^(\s*noise_[yc]:\s*)(\S+)\s*$", lambda m: f"{m.group(1)}{float(m.group(2)) * k!r}",
+                      text, flags=re.M)
     if n != 2:
         sys.stderr.write(f"{base}: expected the keys noise_y and noise_c once each, found {n}\n")
         sys.exit(1)

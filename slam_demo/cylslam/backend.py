@@ -498,6 +498,11 @@ def is_far(o, p):
         p.max_range_rel_sigma is not None and math.sqrt(max(o.cov[0, 0], 0.0)) > p.max_range_rel_sigma * o.range_m)
 
 
+def bearing_only(o, p):
+    """The run uses this observation for its bearing alone (Params.far_bearing and a far one)."""
+    return p.far_bearing and is_far(o, p)
+
+
 class Slam:
     def __init__(self, params: Params, progress=None, on_step=None):
         """on_step(i, seq, t, pose, used, isam, lms_init): called after each step as the run
@@ -526,7 +531,7 @@ class Slam:
     def _plain_factor(self, k, j, o, c):
         """An observation's factor without calibration states, covariance c (range, bearing):
         range and bearing, or the bearing alone for a far one (Params.far_bearing)."""
-        if self.p.far_bearing and is_far(o, self.p):
+        if bearing_only(o, self.p):
             return gtsam.BearingFactor2D(X(k), L(j), gtsam.Rot2(o.bearing_rad), self._bearing_noise(c))
         return gtsam.BearingRangeFactor2D(X(k), L(j), gtsam.Rot2(o.bearing_rad), o.range_m, self._obs_noise(c))
 
@@ -683,7 +688,7 @@ class Slam:
         far_last = {}                       # landmark -> the time of its last far bearing used
 
         def add_observation(k, o, c, j):
-            far = p.far_bearing and is_far(o, p)
+            far = bearing_only(o, p)
             if far and p.far_bearing_every_s > 0:
                 t = steps[k].t
                 if j in far_last and t - far_last[j] < p.far_bearing_every_s:
@@ -707,6 +712,8 @@ class Slam:
                         cf = jpx @ np.diag(var_px) @ jpx.T
                 if p.fixed_frame_cov is not None:
                     cf = p.fixed_frame_cov
+                elif far:
+                    cf = cf * p.far_bearing_var_scale   # (the fixed-covariance runs keep theirs)
                 bk = []
                 if use_gm and lm_bias[j] is None:
                     raise ValueError(f"{o.where}: --bias-gm needs the observation's bias_var_px2 (the "
@@ -736,13 +743,10 @@ class Slam:
                 if rbm is not None:
                     if o.u_px is None:
                         raise ValueError(f"{o.where}: --calib-model exact needs the observation's u_px, v_px")
-                    if far and p.fixed_frame_cov is None:
-                        cf = cf * p.far_bearing_var_scale
                     f = calib_factor_exact(X(k), L(j), o, cf, rbm, self._robust(), bk, bearing_only=far)
                     st["exact_factors"] += 1
                 else:
-                    sc = p.far_bearing_var_scale if p.fixed_frame_cov is None else 1.0
-                    noise = self._bearing_noise(cf * sc) if far else self._obs_noise(cf)
+                    noise = self._bearing_noise(cf) if far else self._obs_noise(cf)
                     f = calib_factor(X(k), L(j), o, noise, bk, bearing_only=far)
             else:
                 f = self._plain_factor(k, j, o, c)
@@ -844,6 +848,7 @@ class Slam:
 
             st["dropped_unconfirmed"] += pending.expire(i)
             for o, c, j in zip(usable, covs, targets):
+                far = bearing_only(o, p)
                 if j == -3:
                     st["dropped_ambiguous"] += 1
                     continue
@@ -852,7 +857,7 @@ class Slam:
                     continue
                 if mode == "known" or (mode == "mixed" and o.lm_id is not None):
                     j = id_to_lm.get(o.lm_id, -1)   # may have been created earlier this frame
-                elif j == -1 and p.init_views > 1 and not (p.far_bearing and is_far(o, p)):
+                elif j == -1 and p.init_views > 1 and not far:
                     cand = pending.add(i, cur, o, c)
                     if cand is None:
                         continue                    # waits in the candidate buffer
@@ -860,7 +865,7 @@ class Slam:
                     for (k, ok, ck) in cand["views"]:
                         add_observation(k, ok, ck, j)
                     continue
-                if j == -1 and p.far_bearing and is_far(o, p):
+                if j == -1 and far:
                     st["dropped_far_new"] += 1      # a bearing alone starts no landmark
                     continue
                 if j == -1:

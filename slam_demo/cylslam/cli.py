@@ -123,11 +123,11 @@ def _r(v, n=4):
 
 
 def _used_whole(res, p):
-    """The main run's observations used for range and bearing (not those kept for their bearing
-    alone, whose range variance is not used: --far-bearing); all of them if none is."""
-    from .backend import is_far
-    whole = [o for (_, o, _) in res.assoc if not (p.far_bearing and is_far(o, p))]
-    return whole or [o for (_, o, _) in res.assoc]
+    """The main run's observations used for range and bearing, not those kept for their bearing
+    alone (--far-bearing), whose range variance no factor uses. Every landmark has one: a bearing
+    starts none."""
+    from .backend import bearing_only
+    return [o for (_, o, _) in res.assoc if not bearing_only(o, p)]
 
 
 def mean_obs_cov(res, p):
@@ -366,7 +366,7 @@ def last_line(s, extra=None):
 
 def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="grid",
                max_range_rel_sigma_default=0.0, reject_default="0x320", far_bearing_default=False,
-               far_bearing_scale_default=1.0, far_bearing_every_default=0.0):
+               far_bearing_every_default=0.0):
     g = sp.add_argument_group("back end")
     g.add_argument("--assoc", choices=["auto", "known", "unknown", "mixed"], default=assoc_default,
                    help="data association: known identities, unknown (Mahalanobis gating), mixed "
@@ -432,7 +432,8 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
                         "--reject-flags, or --max-range-rel-sigma) for its bearing alone: with "
                         "--calib-states its image column; it starts no landmark (default: %s)"
                         % ("on" if far_bearing_default else "off"))
-    g.add_argument("--far-bearing-scale", type=float, default=far_bearing_scale_default, metavar="S",
+    from .backend import Params
+    g.add_argument("--far-bearing-scale", type=float, default=Params.far_bearing_var_scale, metavar="S",
                    help="with --far-bearing and --calib-states: that bearing's variance (the "
                         "frame's) times S (default %(default)s)")
     g.add_argument("--far-bearing-every", type=float, default=far_bearing_every_default, metavar="T",

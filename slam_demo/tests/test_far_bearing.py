@@ -7,7 +7,7 @@ import gtsam
 import numpy as np
 import pytest
 
-from cylslam.backend import B, CALIB, L, X, Params, Slam, calib_factor, calib_factor_exact, drop_reason, rb_jacobians
+from cylslam.backend import B, L, X, Params, Slam, calib_factor, calib_factor_exact, drop_reason, rb_jacobians
 from cylslam.data import FLAG_CUT, FLAG_NONLINEAR, Dataset, Obs, Step, compose, wrap
 from cylslam.metrics import evaluate
 
