@@ -83,6 +83,9 @@ const char *kUsage =
     "                       needed for confidence (synthetic default: the scene's)\n"
     "  --centroid-var-floor PX2   lower bound on each centroid variance, px^2 (default 0): a\n"
     "                       model-error term for the centroid's geometric bias (docs/synthetic.md)\n"
+    "  --partial-aspect-min F   flag an observation 0x800 (partly hidden) when its blob's\n"
+    "                       width-to-height ratio is under F, or over 1/F, times a whole\n"
+    "                       landmark's there (default 0.8; 0: off; docs/uncertainty.md)\n"
     "  --overlay DIR|FILE.avi   write overlay images (PNG per frame) or a video\n"
     "  --show               show the overlay in a window (needs a display; q or Esc stops)\n"
     "clutter rejection (per class with CLASS=VALUE, every class with VALUE; the command line\n"
@@ -114,6 +117,7 @@ struct Args {
     std::string config, roi, mask;
     std::vector<std::string> sizes, controls, min_area, max_area, merge_gap, size_gate;
     double var_floor_px2 = 0.0;
+    double partial_aspect_min = -1.0;   // < 0: libcyl's default
     std::string silhouette_sigma;
     uint64_t max_frames = 0;
     bool show = false, quiet = false, fixed_exposure = false, lenient = false;
@@ -175,6 +179,11 @@ Args parse(int argc, char **argv)
         else if (s == "--centroid-var-floor") {
             a.var_floor_px2 = parse_double(s, val(s));
             if (a.var_floor_px2 < 0) usage_error("--centroid-var-floor: must be >= 0 px^2");
+        }
+        else if (s == "--partial-aspect-min") {
+            a.partial_aspect_min = parse_double(s, val(s));
+            if (!(a.partial_aspect_min >= 0 && a.partial_aspect_min <= 2))
+                usage_error("--partial-aspect-min: must be 0..2 (0: off)");
         }
         else if (s == "--overlay") {
             a.overlay = val(s);
@@ -359,6 +368,7 @@ int cmd_detect(const Args &a)
         cfg.observe.silhouette_sigma_v_px = sv;
     }
     cfg.observe.min_var_px2 = a.var_floor_px2;
+    if (a.partial_aspect_min >= 0) cfg.observe.partial_aspect_min = a.partial_aspect_min;
     cyl_camera cam;
     if (!a.calib.empty()) {
         CameraCalibration cal = load_mounted_camera_calibration(a.calib, a.lenient);

@@ -18,6 +18,7 @@ cyl_observe_params cyl_observe_params_default(void)
     p.min_area = 1;
     p.min_var_px2 = 0.0;
     p.nonlinear_rel_sigma = 0.055;
+    p.partial_aspect_min = CYL_PARTIAL_ASPECT_MIN_DEFAULT;
     p.silhouette_rel_sigma = 0.25;
     p.silhouette_sigma_u_px = 0.25;
     p.silhouette_sigma_v_px = 0.25;
@@ -189,6 +190,10 @@ static void locate(cyl_observation *o, const cyl_camera *cam, const cyl_observe_
             o->confidence_uncut = c.confidence_uncut;
             o->w_est_px = c.w_est_px;
             o->h_est_px = c.h_est_px;
+            o->aspect_rel = c.ratio_w / c.ratio_h;
+            if (p->partial_aspect_min > 0.0 &&
+                (o->aspect_rel < p->partial_aspect_min || o->aspect_rel * p->partial_aspect_min > 1.0))
+                o->flags |= CYL_OBS_PARTIAL;
         } else {
             o->flags |= CYL_OBS_NO_SIZE;
         }

@@ -261,6 +261,8 @@ def observe(table: Table, frame: np.ndarray, fmt: str, camera: Camera,
             "cov_frame": [o.cov_rb_frame[0][0], o.cov_rb_frame[0][1], o.cov_rb_frame[1][1]],
             "bias_var_px2": [o.bias_var_u_px2, o.bias_var_v_px2],
         })
+        if o.aspect_rel > 0.0:
+            out[-1]["aspect_rel"] = o.aspect_rel
         if o.subpixel_du_px != 0.0 or o.subpixel_dv_px != 0.0:
             out[-1]["subpixel_shift_px"] = [o.subpixel_du_px, o.subpixel_dv_px]
     del keep

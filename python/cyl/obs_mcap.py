@@ -50,6 +50,7 @@ SCHEMAS: Dict[str, dict] = {
         "confidence": _n("0..1, that the blob is a landmark of its class"),
         "u_px": _n("px, measurement point column"), "v_px": _n("px, row"),
         "var_u_px2": _n("px^2"), "var_v_px2": _n("px^2"), "area_px": {"type": "integer"},
+        "aspect_rel": _n("blob width/height over the whole landmark's, < 1 a side hidden"),
         "flags": {"type": "integer"}, "bbox_px": {"type": "array", "items": {"type": "integer"},
                                                   "description": "x0 y0 x1 y1, px, inclusive"},
         "jac_calib": {"type": "array", "items": NUM}, "cov_frame": {"type": "array", "items": NUM},

@@ -185,6 +185,59 @@ static void test_flags(void **st)
 }
 
 /* End to end: a rectangle drawn in a synthetic frame, segmented by cyl_segment, observed. */
+/* aspect_rel and CYL_OBS_PARTIAL: a whole landmark's box has the expected width-to-height ratio
+ * (aspect_rel = (w/h) / (w_est/h_est), near 1 up to the rounding of its corners); the same landmark
+ * with a side hidden (60% of its width seen) or its top hidden (60% of its height seen) is flagged,
+ * at the threshold's two sides; threshold 0: never. */
+static void test_partial(void **st)
+{
+    cyl_camera cam;
+    cyl_observe_params p = cyl_observe_params_default();
+    cyl_observation obs[8];
+    uint32_t n;
+    double u, v, w, hh;
+    int x0, y0, x1, y1, i;
+    cyl_rb_result r;
+    (void)st;
+    unc_paper_camera(&cam);
+    assert_true(p.partial_aspect_min > 0.5 && p.partial_aspect_min < 1.0);
+    p.silhouette_rel_sigma = -1;
+    p.size[0].diameter_m = 0.16;
+    p.size[0].height_m = 0.30;
+    assert_int_equal(cyl_rb_project(&cam, 1.5, 0.2, &u, &v), CYL_OK);
+    assert_int_equal(cyl_range_bearing(&cam, CYL_GEOM_EXACT, u, v, 0, 0, 0, &r), CYL_OK);
+    w = cam.fx_px * 0.16 / r.depth_m;
+    hh = cam.fy_px * 0.30 / r.depth_m;
+    x0 = (int)lround(u - w / 2 + 0.5);
+    y0 = (int)lround(v - hh / 2 + 0.5);
+    x1 = (int)lround(u + w / 2 - 0.5);
+    y1 = (int)lround(v + hh / 2 - 0.5);
+    hs_init(&H);
+    hs_rect(&H, 0, x0, y0, x1, y1);                                   /* whole */
+    hs_rect(&H, 0, x0 + 200, y0, x0 + 200 + (int)lround(0.6 * (x1 - x0 + 1)) - 1, y1);  /* a side hidden */
+    hs_rect(&H, 0, x0 - 200, y1 - (int)lround(0.6 * (y1 - y0 + 1)) + 1, x1 - 200, y1);  /* top hidden */
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_int_equal(n, 3);
+    for (i = 0; i < 3; i++)   /* the definition, from the observation's own fields */
+        assert_true(fabs(obs[i].aspect_rel - (obs[i].w_px / obs[i].h_px) / (obs[i].w_est_px / obs[i].h_est_px)) < 1e-12);
+    assert_true(fabs(obs[0].aspect_rel - 1.0) < 0.06);
+    assert_false(obs[0].flags & CYL_OBS_PARTIAL);
+    assert_true(obs[1].aspect_rel > 0.5 && obs[1].aspect_rel < 0.7);
+    assert_true(obs[1].flags & CYL_OBS_PARTIAL);
+    assert_true(obs[2].aspect_rel > 1.0 / 0.7 && obs[2].aspect_rel < 2.0);
+    assert_true(obs[2].flags & CYL_OBS_PARTIAL);
+    /* the threshold's edges: just inside the band, not flagged */
+    p.partial_aspect_min = obs[1].aspect_rel * 0.999;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_false(obs[1].flags & CYL_OBS_PARTIAL);
+    p.partial_aspect_min = 1.0 / obs[2].aspect_rel * 0.999;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_false(obs[2].flags & CYL_OBS_PARTIAL);
+    p.partial_aspect_min = 0.0;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    for (i = 0; i < 3; i++) assert_false(obs[i].flags & CYL_OBS_PARTIAL);
+}
+
 static void test_end_to_end(void **st)
 {
     static cyl_colortable t;
@@ -544,6 +597,7 @@ int main(void)
         cmocka_unit_test(test_rendered_landmarks),
         cmocka_unit_test(test_silhouette_corrected),
         cmocka_unit_test(test_flags),
+        cmocka_unit_test(test_partial),
         cmocka_unit_test(test_end_to_end),
         cmocka_unit_test(test_groups_end_to_end),
     };
