@@ -76,6 +76,26 @@ grep -q '"subpixel_shift_px"' "$T/t.jsonl" && fail "subpixel_shift_px with --edg
 [ "$(grep -c '"type":"obs"' "$T/t.jsonl")" -eq "$(grep -c '"type":"obs"' "$T/o.jsonl")" ] || fail "--edges changed the observation count"
 expect_exit 2 "--silhouette-sigma: expected U,V" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB --silhouette-sigma 0.1 --out "$T/x.jsonl"
 expect_exit 2 "--silhouette-sigma: each must be 0..100 px" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB --silhouette-sigma 0.1,-1 --out "$T/x.jsonl"
+# with the classes' sizes every observation with a range carries aspect_rel, and
+# --partial-aspect-min F flags 0x800 exactly where it lies outside [F, 1/F] (default 0.8)
+SIZES="--size orange=0.10,0.30 --size green=0.10,0.30"
+expect_exit 0 "" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB $SIZES --out "$T/a.jsonl" --quiet
+expect_exit 0 "" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB $SIZES --partial-aspect-min 0.999 --out "$T/p.jsonl" --quiet
+python3 - "$T/a.jsonl" "$T/p.jsonl" <<'PY' || fail "0x800 not where aspect_rel says"
+import json, sys
+for path, m in ((sys.argv[1], 0.8), (sys.argv[2], 0.999)):
+    n = 0
+    for line in open(path):
+        o = json.loads(line)
+        if o["type"] != "obs":
+            continue
+        assert "aspect_rel" in o or o["flags"] & 0x100, (path, o["seq"], "no aspect_rel")
+        a = o.get("aspect_rel", 1.0)
+        assert bool(o["flags"] & 0x800) == (a < m or a * m > 1), (path, o["seq"], a, o["flags"])
+        n += bool(o["flags"] & 0x800)
+    assert m == 0.8 or n > 0, "0.999 flagged nothing"
+PY
+expect_exit 2 "--partial-aspect-min: must be 0..2" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB --partial-aspect-min -1 --out "$T/x.jsonl"
 finish
 
 start stdout_stream
