@@ -13,7 +13,7 @@ Conventions
   world frame so that estimates and their covariances can be compared with truth), else at the
   origin.
 
-Data association (`assoc="unknown"`): per frame, for the usable observations (flags & 0x320 == 0,
+Data association (`assoc="unknown"`): per frame, for the usable observations (flags & 0xB20 == 0,
 a range, confidence >= conf_min): candidates are landmarks of the same class whose estimate lies
 within `cand_radius` m of the observation's predicted world position. For the frame's current pose
 and all candidates one iSAM2 joint marginal covariance Sigma is computed; each (observation,
@@ -30,6 +30,11 @@ the data instead. Options (off by default; slam_demo/README.md has their measure
 replaces the Hungarian assignment by joint compatibility branch and bound (`_jcbb`), `exclusion`
 lets an observation whose compatible landmarks are all taken in its frame start a landmark, and
 `merge_every` merges duplicates (`_merge`).
+
+Far observations (`far_bearing`): one dropped only as far is a bearing-only factor; with
+`far_init` one that starts no landmark waits in a bearing track (`FarTracks`) until its rays
+triangulate, and the landmark then starts from bearings alone (no range factor); `far_robust`
+puts a robust kernel on the bearing-only factors.
 """
 from __future__ import annotations
 
@@ -393,7 +398,7 @@ class Params:
     merge_every: int = 0           # unknown association: every N steps, two landmarks of a class
                                    # never seen in one frame whose difference is inside the gate
                                    # (joint marginal) become one; 0: never
-    reject_flags: int = FLAGS_REJECT  # obs.flags bits that drop an observation (format: 0x320)
+    reject_flags: int = FLAGS_REJECT  # obs.flags bits that drop an observation (format: 0xB20)
     max_range_rel_sigma: Optional[float] = None  # drop an observation whose range sigma exceeds this
                                    # times its range (its range is then far from Gaussian); None: keep
     robust: str = "none"           # none | huber | cauchy
@@ -434,6 +439,23 @@ class Params:
                                    # many seconds (consecutive views repeat the centroid's drift,
                                    # and hundreds of them turn a small error of their variance
                                    # into an over-confident trajectory); the others are dropped
+    far_robust: str = "none"       # none | huber | cauchy: the kernel on the bearing-only factors
+                                   # (scale huber_k; `robust` covers them too when set). A far
+                                   # landmark partly hidden by something in front moves its
+                                   # centroid by a share of a pixel long before its box shows it
+                                   # (CYL_OBS_PARTIAL), tens of the bearing's sigmas
+    far_init: bool = False         # with far_bearing: a far observation that starts no landmark
+                                   # waits in a bearing track (FarTracks); a track whose bearings,
+                                   # at the poses' current estimates, triangulate with enough
+                                   # parallax starts a landmark from its bearings alone
+    far_init_parallax_deg: float = 5.0   # the spread of a track's rays needed to start it, degrees
+    far_init_views: int = 5        # and at least this many views from distinct steps
+    far_init_window: int = 150     # steps a track waits for its next view before it is dropped
+    far_init_clear_m: float = 0.5  # a track triangulated nearer than this to a mapped landmark of
+                                   # its class is dropped (that landmark's far views gated badly)
+    far_init_range_scale: float = 2.0   # a view joins the track whose point is inside the gate of
+                                   # its range-bearing point, the range's sigma times this (a far
+                                   # range is biased: it places views, it enters no factor)
 
     def check(self):
         """The batch re-association's and the starts' constraints: ValueError naming the option
@@ -454,6 +476,16 @@ class Params:
                              "and two correlation times > 0 s")
         if not (self.far_bearing_var_scale > 0):
             raise ValueError(f"--far-bearing-scale {self.far_bearing_var_scale}: must be > 0")
+        if self.far_robust not in ("none",) + tuple(ROBUST_KERNELS):
+            raise ValueError(f"--far-robust {self.far_robust!r}: none, huber or cauchy")
+        if self.far_init and not self.far_bearing:
+            raise ValueError("--far-init needs --far-bearing (a track's landmark lives on bearings)")
+        if not (self.far_init_parallax_deg > 0) or self.far_init_views < 2 or self.far_init_window < 1 \
+                or not (self.far_init_range_scale > 0):
+            raise ValueError(f"--far-init-parallax {self.far_init_parallax_deg} / --far-init-views "
+                             f"{self.far_init_views} / --far-init-window {self.far_init_window} / "
+                             f"--far-init-range-scale {self.far_init_range_scale}: parallax > 0 deg, "
+                             "views >= 2, window >= 1 step, range scale > 0")
         if not (self.far_bearing_every_s >= 0):
             raise ValueError(f"--far-bearing-every {self.far_bearing_every_s}: must be >= 0 s")
         if np.any(sig > 0) and (not self.calib_states or self.lm_bias == "none"):
@@ -538,8 +570,17 @@ class Slam:
     def _bearing_noise(self, cov_rb):
         """A bearing-only factor's noise: the bearing's variance (cov_rb in (range, bearing) order)."""
         g = gtsam.noiseModel.Isotropic.Sigma(1, math.sqrt(max(cov_rb[1, 1], 1e-18)))
-        k = self._robust()
+        k = self._far_robust()
         return g if k is None else gtsam.noiseModel.Robust.Create(k, g)
+
+    def _far_robust(self):
+        """The robust kernel bearing-only factors are wrapped in (Params.far_robust, else
+        Params.robust), or None."""
+        if self.p.robust == "none" and self.p.far_robust != "none":
+            if self.p.far_robust not in ROBUST_KERNELS:
+                raise ValueError(f"unknown robust kernel {self.p.far_robust!r}")
+            return ROBUST_KERNELS[self.p.far_robust].Create(self.p.huber_k)
+        return self._robust()
 
     def _bias_prior(self, o, use_calib):
         """The prior variance (u, v) px^2 of a new landmark's centroid-bias state, or None for no
@@ -653,7 +694,8 @@ class Slam:
         st = dict(obs_total=0, dropped_flags=0, dropped_no_range=0, dropped_confidence=0, dropped_far=0,
                   dropped_ambiguous=0, dropped_imprecise=0, used=0, new_landmarks=0, isam_updates=0,
                   marginal_calls=0, new_by_exclusion=0, dropped_unconfirmed=0, association=mode, by_identity=0, bias_states=0, exact_factors=0, gm_states=0,
-                  bearing_only=0, dropped_far_new=0, dropped_far_decimated=0)
+                  bearing_only=0, dropped_far_new=0, dropped_far_decimated=0, far_landmarks=0,
+                  far_tracks_rejected=0)
         last_update = 0
         merged_into = {}                    # landmark -> the landmark it was merged into
         co_seen = set()                     # (j, k), j < k: landmarks observed in one frame
@@ -662,6 +704,7 @@ class Slam:
         gate = chi2_2dof(p.gate_p)
         new_thr = chi2_2dof(p.new_p)
         pending = CandidateBuffer(p.init_views, p.init_window, gate)
+        tracks = FarTracks(p, gate)
 
         # a landmark's start and an observation's factor; `i`, `here`, `new_f` and `new_v` are
         # read from the step being processed when they are called
@@ -743,7 +786,8 @@ class Slam:
                 if rbm is not None:
                     if o.u_px is None:
                         raise ValueError(f"{o.where}: --calib-model exact needs the observation's u_px, v_px")
-                    f = calib_factor_exact(X(k), L(j), o, cf, rbm, self._robust(), bk, bearing_only=far)
+                    f = calib_factor_exact(X(k), L(j), o, cf, rbm, self._far_robust() if far else self._robust(), bk,
+                                           bearing_only=far)
                     st["exact_factors"] += 1
                 else:
                     noise = self._bearing_noise(cf) if far else self._obs_noise(cf)
@@ -847,6 +891,7 @@ class Slam:
             here = []                       # (observation, landmark) used at this step
 
             st["dropped_unconfirmed"] += pending.expire(i)
+            st["dropped_far_new"] += tracks.expire(i)
             for o, c, j in zip(usable, covs, targets):
                 far = bearing_only(o, p)
                 if j == -3:
@@ -866,7 +911,26 @@ class Slam:
                         add_observation(k, ok, ck, j)
                     continue
                 if j == -1 and far:
-                    st["dropped_far_new"] += 1      # a bearing alone starts no landmark
+                    if not p.far_init:
+                        st["dropped_far_new"] += 1  # a bearing alone starts no landmark
+                        continue
+                    tr = tracks.add(i, cur, o, c)
+                    if tr is None:
+                        continue                    # waits in its track
+                    poses = {k: (cur if k == i else _pose_of(isam, new_v, k)) for k, _, _ in tr["views"]}
+                    pt = tracks.triangulate(tr, poses)
+                    if pt is None:
+                        continue                    # not yet: waits for more views
+                    tracks.remove(tr)
+                    if any(math.hypot(*(lms_init[x] - pt)) < p.far_init_clear_m
+                           for x in by_class.get(o.cls, []) if x not in merged_into):
+                        st["far_tracks_rejected"] += 1
+                        st["dropped_far_new"] += len(tr["views"])
+                        continue
+                    j = new_landmark(tr["views"][0][1], pt)
+                    st["far_landmarks"] += 1
+                    for (k, ok, ck) in tr["views"]:
+                        add_observation(k, ok, ck, j)
                     continue
                 if j == -1:
                     j = new_landmark(o, rb_to_world(cur, o.range_m, o.bearing_rad))
@@ -880,6 +944,7 @@ class Slam:
         t_isam = time.perf_counter() - t0
         st["merged_landmarks"] = len(merged_into)
         st["dropped_unconfirmed"] += pending.expire(n + p.init_window)
+        st["dropped_far_new"] += tracks.expire(n + p.far_init_window)
         isam_poses = _poses(est, n)
         if states_in_batch:
             for key, v in z_init:
@@ -1218,6 +1283,32 @@ def _root(merged_into, j):
     return j
 
 
+def file_view(groups, gate, step, o, cov, w, C):
+    """Files an observation, its point w in the plane with covariance C, into the group of its
+    class (in `groups`, each dict(cls, views [(step, obs, cov)], info: the sum of the views'
+    information matrices, iw: of information @ point, last: the newest view's step)) whose mean it
+    is nearest inside the gate, not counting one already seen at this step, or into a new one;
+    returns that group."""
+    best, bd = None, gate
+    for g in groups:
+        if g["cls"] != o.cls or g["last"] == step:
+            continue
+        m, P = CandidateBuffer.mean(g)
+        d = w - m
+        d2 = float(d @ np.linalg.solve(P + C, d))
+        if d2 <= bd:
+            best, bd = g, d2
+    if best is None:
+        best = dict(cls=o.cls, views=[], info=np.zeros((2, 2)), iw=np.zeros(2), last=step)
+        groups.append(best)
+    info = np.linalg.inv(C)
+    best["views"].append((step, o, cov))
+    best["info"] = best["info"] + info
+    best["iw"] = best["iw"] + info @ w
+    best["last"] = step
+    return best
+
+
 class CandidateBuffer:
     """Delayed landmark initialisation: observations that would start a landmark wait here until
     `views` of them, from distinct steps and of one class, agree on a point in the plane (each new
@@ -1239,24 +1330,7 @@ class CandidateBuffer:
     def add(self, step, pose, o, cov):
         """File the observation; returns its candidate once confirmed (and leaves it out of the
         buffer), else None."""
-        w, C = self._point(pose, o, cov)
-        best, bd = None, self.gate
-        for c in self.cands:
-            if c["cls"] != o.cls or c["last"] == step:
-                continue
-            m, P = self.mean(c)
-            d = w - m
-            d2 = float(d @ np.linalg.solve(P + C, d))
-            if d2 <= bd:
-                best, bd = c, d2
-        if best is None:
-            best = dict(cls=o.cls, views=[], info=np.zeros((2, 2)), iw=np.zeros(2), last=step)
-            self.cands.append(best)
-        info = np.linalg.inv(C)
-        best["views"].append((step, o, cov))
-        best["info"] = best["info"] + info
-        best["iw"] = best["iw"] + info @ w
-        best["last"] = step
+        best = file_view(self.cands, self.gate, step, o, cov, *self._point(pose, o, cov))
         if len(best["views"]) >= self.views:
             self.cands.remove(best)
             return best
@@ -1273,6 +1347,85 @@ class CandidateBuffer:
         old = [c for c in self.cands if step - c["last"] > self.window]
         self.cands = [c for c in self.cands if step - c["last"] <= self.window]
         return sum(len(c["views"]) for c in old)
+
+
+class FarTracks:
+    """Landmarks seen only far away (their range unusable, Params.far_bearing) start from their
+    bearings: each such observation joins the track of its class whose point it gates with (the
+    range-bearing point in the plane, the range's sigma times far_init_range_scale, the pose taken
+    as known) or opens one; a track with far_init_views views from distinct steps whose rays spread
+    over far_init_parallax_deg is triangulated from its bearings at the poses' current estimates
+    (Gauss-Newton, each view weighted by its bearing variance). A track not seen for
+    far_init_window steps is dropped."""
+
+    def __init__(self, p, gate):
+        self.p, self.gate = p, gate
+        self.tracks = []                    # dict(cls, views [(step, obs, cov)], info, iw, last, rays)
+
+    def _point(self, pose, o, cov):
+        k = self.p.far_init_range_scale
+        c = np.array(cov, float) * np.array([[k * k, k], [k, 1.0]])
+        return CandidateBuffer._point(pose, o, c)
+
+    def add(self, step, pose, o, cov):
+        """File the far observation; returns its track when it has enough views and parallax to be
+        triangulated (it stays filed: remove() takes it out), else None."""
+        best = file_view(self.tracks, self.gate, step, o, cov, *self._point(pose, o, cov))
+        best.setdefault("rays", [])
+        a = pose[2] + o.bearing_rad
+        best["rays"].append(a if not best["rays"] else best["rays"][0] + wrap(a - best["rays"][0]))
+        if (len(best["views"]) >= self.p.far_init_views
+                and max(best["rays"]) - min(best["rays"]) >= math.radians(self.p.far_init_parallax_deg)):
+            return best
+        return None
+
+    def remove(self, t):
+        self.tracks.remove(t)
+
+    def triangulate(self, t, poses):
+        """The track's point from its bearings at `poses` (step -> pose), or None when the rays at
+        those poses do not meet in front of every view with the parallax asked, or a bearing's
+        residual exceeds 6 of its sigmas (a track that mixes two objects)."""
+        pt = CandidateBuffer.mean(t)[0].copy()
+        P = np.array([poses[k][:2] for k, _, _ in t["views"]], float)
+        th = np.array([poses[k][2] for k, _, _ in t["views"]], float)
+        b = np.array([o.bearing_rad for _, o, _ in t["views"]], float)
+        sig = np.sqrt(np.array([max(c[1, 1], 1e-12) for _, _, c in t["views"]], float))
+        for _ in range(20):
+            d = pt - P
+            q = np.maximum(np.einsum("ij,ij->i", d, d), 1e-9)
+            r = np.array([wrap(x) for x in b - (np.arctan2(d[:, 1], d[:, 0]) - th)]) / sig
+            H = np.c_[-d[:, 1] / q, d[:, 0] / q] / sig[:, None]
+            step = np.linalg.lstsq(H, r, rcond=None)[0]
+            pt = pt + step
+            if not np.all(np.isfinite(pt)):
+                return None
+            if np.linalg.norm(step) < 1e-7:
+                break
+        d = pt - P
+        ray = np.c_[np.cos(th + b), np.sin(th + b)]
+        if np.any(np.einsum("ij,ij->i", d, ray) <= 0):
+            return None
+        ang = np.arctan2(-d[:, 1], -d[:, 0])
+        ang = ang[0] + np.array([wrap(x - ang[0]) for x in ang])
+        if ang.max() - ang.min() < math.radians(self.p.far_init_parallax_deg):
+            return None
+        r = np.array([wrap(x) for x in b - (np.arctan2(d[:, 1], d[:, 0]) - th)]) / sig
+        if np.any(np.abs(r) > 6.0):
+            return None
+        return pt
+
+    def expire(self, step):
+        """Drops the tracks not seen since step - window; returns how many observations they held."""
+        old = [t for t in self.tracks if step - t["last"] > self.p.far_init_window]
+        self.tracks = [t for t in self.tracks if step - t["last"] <= self.p.far_init_window]
+        return sum(len(t["views"]) for t in old)
+
+
+def _pose_of(isam, new_v, k):
+    """Step k's pose estimate: the values not yet given to iSAM2, else iSAM2's."""
+    e = new_v.atPose2(X(k)) if new_v.exists(X(k)) else isam.calculateEstimatePose2(X(k))
+    return np.array([e.x(), e.y(), e.theta()])
 
 
 class Information:

@@ -14,13 +14,14 @@ from typing import Optional
 
 import numpy as np
 
-# obs.flags bits (docs/formats.md): a back end uses observations with flags & 0x320 == 0
+# obs.flags bits (docs/formats.md): a back end uses observations with flags & 0xB20 == 0
 FLAG_MERGED = 0x10
 FLAG_CUT = 0x20
 FLAG_NO_RANGE = 0x100
 FLAG_INVALID = 0x200
 FLAG_NONLINEAR = 0x400
-FLAGS_REJECT = 0x320
+FLAG_PARTIAL = 0x800      # a side of the landmark hidden: its centroid (bearing too) is off
+FLAGS_REJECT = 0xB20
 
 
 @dataclass

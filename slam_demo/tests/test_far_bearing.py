@@ -212,3 +212,65 @@ def test_one_far_bearing_a_landmark_every_interval():
         assert sum(1 for (_, o, _) in res.assoc if not o.flags) == 3 * 120 + 1   # every near view
     with pytest.raises(ValueError, match="--far-bearing-every -1.0: must be >= 0 s"):
         Params(far_bearing_every_s=-1.0).check()
+
+
+def test_triangulate_from_bearings():
+    """FarTracks.triangulate: bearings from known poses give the point back; rays that spread less
+    than the parallax asked, or a view 40 sigmas off (a track that mixes two objects), give None."""
+    from cylslam.backend import FarTracks
+    pt = np.array([4.0, 3.0])
+    p = Params(far_bearing=True, far_init=True, far_init_parallax_deg=5.0, far_init_views=3)
+    tracks = FarTracks(p, gate=9.21)
+    sb = 1e-3
+    poses, views = {}, []
+    for k in range(8):
+        pose = np.array([0.2 * k, -0.1 * k, 0.05 * k])
+        b = wrap(np.arctan2(pt[1] - pose[1], pt[0] - pose[0]) - pose[2])
+        r = np.hypot(*(pt - pose[:2])) * 1.15          # a far range: 15% long, it only places the view
+        poses[k] = pose
+        views.append(Obs(cls="orange", range_m=r, bearing_rad=float(b), cov=np.diag([0.3 ** 2, sb ** 2])))
+    got = None
+    for k, o in enumerate(views):
+        got = tracks.add(k, poses[k], o, o.cov)
+    assert got is not None and len(tracks.tracks) == 1 and len(got["views"]) == 8
+    assert np.allclose(tracks.triangulate(got, poses), pt, atol=1e-6)
+    # the same rays, the parallax asked beyond their spread (about 18 degrees)
+    spread = np.degrees(max(got["rays"]) - min(got["rays"]))
+    assert 15 < spread < 21
+    assert FarTracks(Params(far_bearing=True, far_init=True, far_init_parallax_deg=spread + 1),
+                     9.21).triangulate(got, poses) is None
+    # one bearing 40 sigmas off
+    k0, o0, c0 = got["views"][4]
+    bad = dict(got, views=list(got["views"]))
+    bad["views"][4] = (k0, Obs(cls="orange", range_m=o0.range_m, bearing_rad=o0.bearing_rad + 40 * sb, cov=c0), c0)
+    assert tracks.triangulate(bad, poses) is None
+    # a view of a point elsewhere opens its own track
+    o = Obs(cls="orange", range_m=3.0, bearing_rad=-1.2, cov=np.diag([0.3 ** 2, sb ** 2]))
+    assert tracks.add(9, poses[7], o, o.cov) is None and len(tracks.tracks) == 2
+
+
+def test_far_init_maps_a_landmark_seen_only_far():
+    """Landmark 4 of the circle drive is only ever seen far, its range a fifth too long: with
+    far_init it starts from its bearings (one track, triangulated) and sits where it is, its
+    covariance consistent over the runs; without, it is never mapped."""
+    rng = np.random.default_rng(11)
+    errs, nees = [], []
+    for _ in range(6):
+        ds = _drive(rng)
+        res = Slam(Params(reject_flags=0x720, far_bearing=True, far_init=True)).run(ds)
+        assert res.stats["far_landmarks"] == 1
+        assert evaluate(ds, res)["association_errors"] == 0
+        j4 = list(res.lm_ids).index(4)
+        e = res.lms[j4] - np.array([-6.0, -5.5])
+        errs.append(np.linalg.norm(e))
+        nees.append(e @ np.linalg.solve(res.lm_cov[j4], e))
+        assert 4 not in Slam(Params(reject_flags=0x720, far_bearing=True, covariances=False)).run(ds).lm_ids
+    assert np.median(errs) < 0.1                    # its ranges, used whole, would put it ~1.6 m out
+    assert np.mean(nees) < 4.0                      # 2 dof, 6 runs: mean 2
+
+
+def test_far_init_options():
+    with pytest.raises(ValueError, match="--far-init needs --far-bearing"):
+        Params(far_init=True).check()
+    with pytest.raises(ValueError, match="views >= 2"):
+        Params(far_bearing=True, far_init=True, far_init_views=1).check()
