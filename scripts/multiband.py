@@ -48,6 +48,12 @@ from consistency import run, seeds_arg  # noqa: E402  (the scripts' shared runne
 W, H = 640, 480
 
 
+# "no worse than gating's": to the solvers' agreement, not bit for bit. The two runs give iSAM2 the
+# same graph at different steps (the run with identities updates only when an observation without
+# one needs gating), so the landmarks seen only far away are triangulated at slightly different
+# pose estimates and the batch solutions agree to about 1e-6 m (measured: 6.463 / 6.462 mm).
+ATE_RTOL = 1e-3
+
 def read_scene(path):
     """The scene file (OpenCV FileStorage YAML) as a dict."""
     import yaml
@@ -318,7 +324,7 @@ def main():
         "slam_ate_gated_m": [r[2].get("ate_m") for r in slam_rows],
         "slam_ate_with_ids_le_gated_frac": round(sum(1 for r in slam_rows if r[1].get("ate_m") is not None and
                                                     r[2].get("ate_m") is not None and
-                                                    r[1]["ate_m"] <= r[2]["ate_m"]) / len(slam_rows), 3),
+                                                    r[1]["ate_m"] <= r[2]["ate_m"] * (1 + ATE_RTOL)) / len(slam_rows), 3),
         "slam_landmarks_with_ids": [r[1].get("landmarks_estimated") for r in slam_rows],
         "slam_landmarks_gated": [r[2].get("landmarks_estimated") for r in slam_rows],
         "seconds": round(time.time() - t0, 1),

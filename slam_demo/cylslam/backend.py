@@ -914,7 +914,11 @@ class Slam:
                     if not p.far_init:
                         st["dropped_far_new"] += 1  # a bearing alone starts no landmark
                         continue
-                    tr = tracks.add(i, cur, o, c)
+                    by_id = mode == "known" or (mode == "mixed" and o.lm_id is not None)
+                    if by_id and math.sqrt(max(c[0, 0], o.range_m ** 2 * c[1, 1])) > p.init_max_sigma:
+                        st["dropped_imprecise"] += 1    # the rule gating applies (_associate's -4)
+                        continue
+                    tr = tracks.add(i, cur, o, c, key=o.lm_id if by_id else None)
                     if tr is None:
                         continue                    # waits in its track
                     poses = {k: (cur if k == i else _pose_of(isam, new_v, k)) for k, _, _ in tr["views"]}
@@ -1283,23 +1287,26 @@ def _root(merged_into, j):
     return j
 
 
-def file_view(groups, gate, step, o, cov, w, C):
+def file_view(groups, gate, step, o, cov, w, C, key=None):
     """Files an observation, its point w in the plane with covariance C, into the group of its
     class (in `groups`, each dict(cls, views [(step, obs, cov)], info: the sum of the views'
-    information matrices, iw: of information @ point, last: the newest view's step)) whose mean it
-    is nearest inside the gate, not counting one already seen at this step, or into a new one;
-    returns that group."""
+    information matrices, iw: of information @ point, last: the newest view's step, key)) whose
+    mean it is nearest inside the gate, not counting one already seen at this step, or into a new
+    one; returns that group. With a key (a landmark identity) the group of that key, ungated."""
     best, bd = None, gate
     for g in groups:
-        if g["cls"] != o.cls or g["last"] == step:
+        if g["cls"] != o.cls or g["last"] == step or g.get("key") != key:
             continue
+        if key is not None:
+            best = g
+            break
         m, P = CandidateBuffer.mean(g)
         d = w - m
         d2 = float(d @ np.linalg.solve(P + C, d))
         if d2 <= bd:
             best, bd = g, d2
     if best is None:
-        best = dict(cls=o.cls, views=[], info=np.zeros((2, 2)), iw=np.zeros(2), last=step)
+        best = dict(cls=o.cls, views=[], info=np.zeros((2, 2)), iw=np.zeros(2), last=step, key=key)
         groups.append(best)
     info = np.linalg.inv(C)
     best["views"].append((step, o, cov))
@@ -1367,10 +1374,11 @@ class FarTracks:
         c = np.array(cov, float) * np.array([[k * k, k], [k, 1.0]])
         return CandidateBuffer._point(pose, o, c)
 
-    def add(self, step, pose, o, cov):
-        """File the far observation; returns its track when it has enough views and parallax to be
-        triangulated (it stays filed: remove() takes it out), else None."""
-        best = file_view(self.tracks, self.gate, step, o, cov, *self._point(pose, o, cov))
+    def add(self, step, pose, o, cov, key=None):
+        """File the far observation (key: its landmark identity, when the run associates by
+        identity: the track of that identity); returns its track when it has enough views and
+        parallax to be triangulated (it stays filed: remove() takes it out), else None."""
+        best = file_view(self.tracks, self.gate, step, o, cov, *self._point(pose, o, cov), key=key)
         best.setdefault("rays", [])
         a = pose[2] + o.bearing_rad
         best["rays"].append(a if not best["rays"] else best["rays"][0] + wrap(a - best["rays"][0]))
