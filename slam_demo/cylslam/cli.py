@@ -93,7 +93,8 @@ def _params(args, **over):
                far_bearing_var_scale=getattr(args, "far_bearing_scale", Params.far_bearing_var_scale),
                far_bearing_every_s=getattr(args, "far_bearing_every", Params.far_bearing_every_s),
                far_robust=getattr(args, "far_robust", Params.far_robust),
-               far_init=getattr(args, "far_init", False),
+               far_init=(getattr(args, "far_init_default", False) and getattr(args, "far_bearing", False)
+                         if getattr(args, "far_init", None) is None else args.far_init),
                far_init_parallax_deg=getattr(args, "far_init_parallax", Params.far_init_parallax_deg),
                far_init_views=getattr(args, "far_init_views", Params.far_init_views),
                far_init_window=getattr(args, "far_init_window", Params.far_init_window),
@@ -450,11 +451,14 @@ def add_common(sp, assoc_default="auto", robust_default="none", fixed_default="g
     g.add_argument("--far-robust", choices=("none", "huber", "cauchy"), default=far_robust_default,
                    help="with --far-bearing: the robust kernel on the bearing-only factors (scale "
                         "--huber-k; --robust, when set, covers them too) (default %(default)s)")
-    g.add_argument("--far-init", action=argparse.BooleanOptionalAction, default=far_init_default,
+    # None: the command's default, and off with --no-far-bearing (an explicit --far-init there is
+    # the usage error Params.check names)
+    g.add_argument("--far-init", action=argparse.BooleanOptionalAction, default=None,
                    help="with --far-bearing: a landmark seen only far away starts from its bearings "
                         "(a track of far views whose rays, at the poses' estimates, meet with "
                         "--far-init-parallax degrees of spread; no range enters a factor) "
-                        "(default: %s)" % ("on" if far_init_default else "off"))
+                        "(default: %s)" % ("on with --far-bearing" if far_init_default else "off"))
+    sp.set_defaults(far_init_default=far_init_default)
     g.add_argument("--far-init-parallax", type=float, default=Params.far_init_parallax_deg, metavar="DEG",
                    help="with --far-init: the spread of a track's rays that starts it (default %(default)s)")
     g.add_argument("--far-init-views", type=int, default=Params.far_init_views, metavar="N",

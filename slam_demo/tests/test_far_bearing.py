@@ -270,6 +270,18 @@ def test_far_init_maps_a_landmark_seen_only_far():
 
 
 def test_far_init_options():
+    """cylslam run: far-init on by default with the far bearings, off with --no-far-bearing (not an
+    error), an explicit --far-init without them a usage error; the parallax default 5 degrees."""
+    from cylslam.cli import _params, build_parser
+    p = _params(build_parser().parse_args(["run", "x.jsonl"]))
+    assert p.far_init and p.far_init_parallax_deg == 5.0 and p.far_robust == "cauchy"
+    p = _params(build_parser().parse_args(["run", "x.jsonl", "--no-far-bearing"]))
+    assert not p.far_init
+    p.check()
+    assert not _params(build_parser().parse_args(["run", "x.jsonl", "--no-far-init"])).far_init
+    p = _params(build_parser().parse_args(["run", "x.jsonl", "--no-far-bearing", "--far-init"]))
+    with pytest.raises(ValueError, match="--far-init needs --far-bearing"):
+        p.check()
     with pytest.raises(ValueError, match="--far-init needs --far-bearing"):
         Params(far_init=True).check()
     with pytest.raises(ValueError, match="views >= 2"):
