@@ -54,6 +54,7 @@ W, H = 640, 480
 # pose estimates and the batch solutions agree to about 1e-6 m (measured: 6.463 / 6.462 mm).
 ATE_RTOL = 1e-3
 
+
 def read_scene(path):
     """The scene file (OpenCV FileStorage YAML) as a dict."""
     import yaml

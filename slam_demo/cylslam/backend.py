@@ -530,6 +530,11 @@ def is_far(o, p):
         p.max_range_rel_sigma is not None and math.sqrt(max(o.cov[0, 0], 0.0)) > p.max_range_rel_sigma * o.range_m)
 
 
+def planar_sigma(o, cov):
+    """The observation's largest standard deviation in the plane, m (cov: (range, bearing))."""
+    return math.sqrt(max(cov[0, 0], o.range_m ** 2 * cov[1, 1]))
+
+
 def bearing_only(o, p):
     """The run uses this observation for its bearing alone (Params.far_bearing and a far one)."""
     return p.far_bearing and is_far(o, p)
@@ -547,12 +552,13 @@ class Slam:
     def _odom_noise(self, cov):
         return gtsam.noiseModel.Gaussian.Covariance(np.asarray(cov, float))
 
-    def _robust(self):
-        """The robust kernel observation factors are wrapped in, or None."""
-        if self.p.robust in ROBUST_KERNELS:
-            return ROBUST_KERNELS[self.p.robust].Create(self.p.huber_k)
-        if self.p.robust != "none":
-            raise ValueError(f"unknown robust kernel {self.p.robust!r}")
+    def _robust(self, name=None):
+        """The robust kernel observation factors are wrapped in (Params.robust, or `name`), or None."""
+        name = self.p.robust if name is None else name
+        if name in ROBUST_KERNELS:
+            return ROBUST_KERNELS[name].Create(self.p.huber_k)
+        if name != "none":
+            raise ValueError(f"unknown robust kernel {name!r}")
         return None
 
     def _obs_noise(self, cov_rb):
@@ -574,13 +580,9 @@ class Slam:
         return g if k is None else gtsam.noiseModel.Robust.Create(k, g)
 
     def _far_robust(self):
-        """The robust kernel bearing-only factors are wrapped in (Params.far_robust, else
-        Params.robust), or None."""
-        if self.p.robust == "none" and self.p.far_robust != "none":
-            if self.p.far_robust not in ROBUST_KERNELS:
-                raise ValueError(f"unknown robust kernel {self.p.far_robust!r}")
-            return ROBUST_KERNELS[self.p.far_robust].Create(self.p.huber_k)
-        return self._robust()
+        """The robust kernel bearing-only factors are wrapped in (Params.robust when set, else
+        Params.far_robust), or None."""
+        return self._robust(self.p.far_robust if self.p.robust == "none" else None)
 
     def _bias_prior(self, o, use_calib):
         """The prior variance (u, v) px^2 of a new landmark's centroid-bias state, or None for no
@@ -915,7 +917,7 @@ class Slam:
                         st["dropped_far_new"] += 1  # a bearing alone starts no landmark
                         continue
                     by_id = mode == "known" or (mode == "mixed" and o.lm_id is not None)
-                    if by_id and math.sqrt(max(c[0, 0], o.range_m ** 2 * c[1, 1])) > p.init_max_sigma:
+                    if by_id and planar_sigma(o, c) > p.init_max_sigma:
                         st["dropped_imprecise"] += 1    # the rule gating applies (_associate's -4)
                         continue
                     tr = tracks.add(i, cur, o, c, key=o.lm_id if by_id else None)
@@ -1216,8 +1218,7 @@ class Slam:
         sig = []
         for o, R in zip(usable, covs):
             w = rb_to_world(cur, o.range_m, o.bearing_rad)
-            # largest standard deviation of the observation in the plane
-            s_max = math.sqrt(max(R[0, 0], o.range_m ** 2 * R[1, 1]))
+            s_max = planar_sigma(o, R)
             sig.append(s_max)
             rad = self.p.cand_radius + 3.0 * s_max
             cs = []
@@ -1316,6 +1317,12 @@ def file_view(groups, gate, step, o, cov, w, C, key=None):
     return best
 
 
+def expire_groups(groups, step, window):
+    """(the groups of file_view seen since step - window, how many views the others held)."""
+    keep = [g for g in groups if step - g["last"] <= window]
+    return keep, sum(len(g["views"]) for g in groups if step - g["last"] > window)
+
+
 class CandidateBuffer:
     """Delayed landmark initialisation: observations that would start a landmark wait here until
     `views` of them, from distinct steps and of one class, agree on a point in the plane (each new
@@ -1351,9 +1358,8 @@ class CandidateBuffer:
 
     def expire(self, step):
         """Drops the candidates not seen since step - window; returns how many observations they held."""
-        old = [c for c in self.cands if step - c["last"] > self.window]
-        self.cands = [c for c in self.cands if step - c["last"] <= self.window]
-        return sum(len(c["views"]) for c in old)
+        self.cands, n = expire_groups(self.cands, step, self.window)
+        return n
 
 
 class FarTracks:
@@ -1399,10 +1405,14 @@ class FarTracks:
         th = np.array([poses[k][2] for k, _, _ in t["views"]], float)
         b = np.array([o.bearing_rad for _, o, _ in t["views"]], float)
         sig = np.sqrt(np.array([max(c[1, 1], 1e-12) for _, _, c in t["views"]], float))
-        for _ in range(20):
+
+        def whitened(pt):
+            """(point - view positions, the bearings' whitened residuals)."""
             d = pt - P
+            return d, wrap(b - (np.arctan2(d[:, 1], d[:, 0]) - th)) / sig
+        for _ in range(20):
+            d, r = whitened(pt)
             q = np.maximum(np.einsum("ij,ij->i", d, d), 1e-9)
-            r = np.array([wrap(x) for x in b - (np.arctan2(d[:, 1], d[:, 0]) - th)]) / sig
             H = np.c_[-d[:, 1] / q, d[:, 0] / q] / sig[:, None]
             step = np.linalg.lstsq(H, r, rcond=None)[0]
             pt = pt + step
@@ -1410,24 +1420,22 @@ class FarTracks:
                 return None
             if np.linalg.norm(step) < 1e-7:
                 break
-        d = pt - P
+        d, r = whitened(pt)
         ray = np.c_[np.cos(th + b), np.sin(th + b)]
         if np.any(np.einsum("ij,ij->i", d, ray) <= 0):
             return None
         ang = np.arctan2(-d[:, 1], -d[:, 0])
-        ang = ang[0] + np.array([wrap(x - ang[0]) for x in ang])
+        ang = ang[0] + wrap(ang - ang[0])
         if ang.max() - ang.min() < math.radians(self.p.far_init_parallax_deg):
             return None
-        r = np.array([wrap(x) for x in b - (np.arctan2(d[:, 1], d[:, 0]) - th)]) / sig
         if np.any(np.abs(r) > 6.0):
             return None
         return pt
 
     def expire(self, step):
         """Drops the tracks not seen since step - window; returns how many observations they held."""
-        old = [t for t in self.tracks if step - t["last"] > self.p.far_init_window]
-        self.tracks = [t for t in self.tracks if step - t["last"] <= self.p.far_init_window]
-        return sum(len(t["views"]) for t in old)
+        self.tracks, n = expire_groups(self.tracks, step, self.p.far_init_window)
+        return n
 
 
 def _pose_of(isam, new_v, k):

@@ -132,8 +132,8 @@ def _r(v, n=4):
 
 def _used_whole(res, p):
     """The main run's observations used for range and bearing, not those kept for their bearing
-    alone (--far-bearing), whose range variance no factor uses. Every landmark has one: a bearing
-    starts none."""
+    alone (--far-bearing), whose range variance no factor uses. May be empty: with --far-init a
+    landmark can start from bearings and never be seen near."""
     from .backend import bearing_only
     return [o for (_, o, _) in res.assoc if not bearing_only(o, p)]
 
@@ -182,7 +182,10 @@ def process(ds, args, label, outdir):
         dr = None
     res_fixed = None
     align_fixed = None
-    if args.fixed_cov != "none" and res.assoc:
+    if args.fixed_cov != "none" and res.assoc and not _used_whole(res, _params(args)):
+        summary["fixed_cov_failed"] = ("no observation was used for range and bearing (every landmark "
+                                       "started from far bearings): no covariance to fix")
+    elif args.fixed_cov != "none" and res.assoc:
         # grid/mean: the whole covariance replaced, no calibration states in the fixed runs.
         # frame-grid: the fixed runs keep the calibration and bias states and replace each
         # observation's frame covariance, the per-observation noise estimate, by one matrix: the

@@ -286,3 +286,19 @@ def test_far_init_options():
         Params(far_init=True).check()
     with pytest.raises(ValueError, match="views >= 2"):
         Params(far_bearing=True, far_init=True, far_init_views=1).check()
+
+
+def test_fixed_baseline_with_no_whole_observation():
+    """Every landmark seen only far away: all start from bearings, no observation is used for range
+    and bearing, and the fixed-covariance baseline reports why it has no matrix (the mean of no
+    observation was NaN before)."""
+    from dataclasses import replace
+    from cylslam.cli import build_parser, process
+    ds = _drive(np.random.default_rng(4))
+    for s in ds.steps:
+        s.obs = [replace(o, flags=FLAG_NONLINEAR) for o in s.obs]
+    args = build_parser().parse_args(["run", "x.jsonl", "--assoc", "known", "--no-plot", "--no-progress"])
+    summary = process(ds, args, "far only", None)
+    assert summary["stats"]["far_landmarks"] >= 4
+    assert "no observation was used for range and bearing" in summary["fixed_cov_failed"]
+    assert "ate_fixed_cov_m" not in summary

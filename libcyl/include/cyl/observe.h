@@ -145,7 +145,8 @@ typedef struct cyl_observation {
                                    width-to-height ratio over the whole landmark's at its place in
                                    the image (the depth cancels, so a wrong range does not move
                                    it); about 1 for a whole landmark, < 1 when a side is hidden,
-                                   > 1 when the top or bottom is; 0 when unknown (no size) */
+                                   > 1 when the top or bottom is; 0 when unknown (no size,
+                                   no range) */
     /* The calibration's share, for back ends that estimate the calibration error as a state:
      * it is constant during a run, so per-observation factors with cov_rb are not independent
      * (docs/uncertainty.md, "Constant calibration errors"). */
