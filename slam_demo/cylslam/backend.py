@@ -48,7 +48,7 @@ import gtsam
 import numpy as np
 
 from .camera_model import range_bearing_model
-from .data import FLAG_NO_RANGE, FLAG_NONLINEAR, FLAGS_REJECT, compose, rb_to_world, wrap
+from .data import FLAG_MERGED, FLAG_NO_RANGE, FLAG_NONLINEAR, FLAGS_REJECT, compose, rb_to_world, wrap
 
 PERM = np.array([[0.0, 1.0], [1.0, 0.0]])
 ROBUST_KERNELS = {"huber": gtsam.noiseModel.mEstimator.Huber, "cauchy": gtsam.noiseModel.mEstimator.Cauchy}
@@ -403,6 +403,10 @@ class Params:
                                    # times its range (its range is then far from Gaussian); None: keep
     robust: str = "none"           # none | huber | cauchy
     huber_k: float = 1.345         # the kernel's threshold k on the whitened residual (Huber or Cauchy)
+    merged_var_scale: float = 1.0  # a merged blob's (flag 0x010: more than one 4-connected
+                                   # component; not a grouped landmark of several bands) frame
+                                   # covariance times this (cov_frame, and its share of cov); the
+                                   # calibration's share is the same as any view's
     fixed_cov: Optional[np.ndarray] = None   # replaces every observation covariance (r, b order)
     fixed_frame_cov: Optional[np.ndarray] = None  # with calib_states: replaces every observation's
                                    # frame covariance (the centroid noise, less the bias its state
@@ -474,6 +478,8 @@ class Params:
         if sig.shape != (2,) or tau.shape != (2,) or np.any(~(sig >= 0)) or np.any(~(tau > 0)):
             raise ValueError(f"--bias-gm {tuple(sig)} / --bias-gm-tau {tuple(tau)}: two sigmas >= 0 px "
                              "and two correlation times > 0 s")
+        if not (self.merged_var_scale > 0):
+            raise ValueError(f"--merged-var-scale {self.merged_var_scale}: must be > 0")
         if not (self.far_bearing_var_scale > 0):
             raise ValueError(f"--far-bearing-scale {self.far_bearing_var_scale}: must be > 0")
         if self.far_robust not in ("none",) + tuple(ROBUST_KERNELS):
@@ -538,6 +544,13 @@ def planar_sigma(o, cov):
 def bearing_only(o, p):
     """The run uses this observation for its bearing alone (Params.far_bearing and a far one)."""
     return p.far_bearing and is_far(o, p)
+
+
+def frame_scale(o, p):
+    """The factor on an observation's frame covariance: Params.merged_var_scale for a merged blob
+    (CYL_BLOB_MERGED, 0x010) that is not a grouped landmark of several bands (whose bands are
+    merged by design), else 1."""
+    return p.merged_var_scale if o.flags & FLAG_MERGED and not o.grouped else 1.0
 
 
 class Slam:
@@ -743,7 +756,7 @@ class Slam:
             if use_calib:
                 if o.jac_calib is None:
                     raise ValueError(f"{o.where}: calibration states need jac_calib and cov_frame")
-                cf = o.cov_frame
+                cf = o.cov_frame * frame_scale(o, p)
                 if lm_bias[j] is not None and o.bias_var_px2 is not None:
                     # the bias is the landmark's state now, not noise of this frame: as much of
                     # it as the state's prior covers
@@ -870,7 +883,8 @@ class Slam:
                 continue
             covs = [p.fixed_cov if p.fixed_cov is not None else
                     (o.cov - o.cov_frame + p.fixed_frame_cov
-                     if use_calib and p.fixed_frame_cov is not None and o.cov_frame is not None else o.cov)
+                     if use_calib and p.fixed_frame_cov is not None and o.cov_frame is not None else
+                     o.cov + (frame_scale(o, p) - 1.0) * o.cov_frame if o.cov_frame is not None else o.cov)
                     for o in usable]
             frames.append((i, usable, covs))
             if mode == "known":

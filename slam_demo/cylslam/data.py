@@ -40,6 +40,8 @@ class Obs:
                                   # a part of cov_frame that does not change from frame to frame
     u_px: Optional[float] = None  # the measured point range and bearing were computed from, px
     v_px: Optional[float] = None  # (the camera model's input; None when the source has no pixel)
+    grouped: bool = False         # a landmark of several bands grouped by the frontend (the log's
+                                  # landmark_model): its blob is merged by design, not by noise
 
 
 @dataclass

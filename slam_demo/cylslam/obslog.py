@@ -247,7 +247,7 @@ class _Builder:
             fr = self._frame_of(rec, where, "obs")
             fr["obs"].append(Obs(cls=cls, range_m=r, bearing_rad=b, cov=cov, confidence=conf,
                                  flags=flags, lm_id=lm_id, where=where, jac_calib=jm, cov_frame=cf,
-                                 bias_var_px2=bv, u_px=u, v_px=v))
+                                 bias_var_px2=bv, u_px=u, v_px=v, grouped="landmark_model" in rec))
         elif typ == "odom":
             d = np.array([_num(rec, k, where) for k in ("dx_m", "dy_m", "dtheta_rad")])
             xx, xy, xt, yy, yt, tt = _numlist(rec, "cov", 6, where, " (xx xy xt yy yt tt)")
