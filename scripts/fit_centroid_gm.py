@@ -5,7 +5,7 @@ rendered drives with truth.
 
 For each seed: cyl-render (a drive with a calibration error drawn once; the renderer prints the true
 camera) -> cyl detect (the defaults consistency.py uses). Each kept observation (flags without
-0x320, confidence >= 0.5) is taken through libcyl's camera model (the cyl binding) at the TRUE
+--reject-flags, default 0x320; confidence >= 0.5) is taken through libcyl's camera model (the cyl binding) at the TRUE
 calibration, and its residual in the image -- the pixel offset that would put the observation on
 the true landmark seen from the true pose -- is attributed to the landmark whose bearing it is
 nearest. Residuals of 1 px or more are left out and counted: they are partial occlusions (a box
@@ -15,8 +15,13 @@ cylslam.centroid_noise's model (a constant bias with the frontend's prior, a Gau
 white noise scaled from the frontend's), fitted by maximum likelihood.
 
 Usage: scripts/fit_centroid_gm.py [--seeds 1-20] [--frames 1000] [--build DIR] [--work DIR]
-  --seeds   the drives (default 1-20: the tuning seeds; never the held-out 101-120)
-  --work    where the observation logs are kept between runs (default build/centroid_gm)
+                                  [--reject-flags MASK] [--noise-scale K]
+  --seeds         the drives (default 1-20: the tuning seeds; never the held-out 101-120)
+  --work          where the observation logs are kept between runs (default build/centroid_gm;
+                  a subdirectory per noise scale other than 1)
+  --reject-flags  observations with any of these flag bits are left out (default 0x320: the far
+                  views kept; 0xf20 keeps only what cylslam run uses whole)
+  --noise-scale   render with the scene's sensor noise times K (as consistency.py --noise-scale)
 The last line is one JSON object with the fitted values and the cylslam options they make.
 Exit codes: 0 fitted, 1 a tool failed, 2 bad command line.
 """
@@ -40,7 +45,7 @@ TRUE_CAM = re.compile(r"true camera = calibration \+ error: fx (\S+) fy (\S+) cx
 GROSS_PX = 1.0
 
 
-def drive(build, work, seed, frames):
+def drive(build, work, seed, frames, scene=None):
     """(observation log path, true calibration error in jac_calib's order), rendering if needed."""
     d = os.path.join(work, f"seed{seed}")
     obs, cal = os.path.join(d, "observations.jsonl"), os.path.join(d, "true_calibration.json")
@@ -49,7 +54,7 @@ def drive(build, work, seed, frames):
             c = json.load(f)
         if c.get("frames") == frames:
             return obs, c["delta"]
-    obs, err = render_and_detect(build, d, seed, frames)
+    obs, err = render_and_detect(build, d, seed, frames, scene)
     m = TRUE_CAM.search(err)
     if not m:
         sys.stderr.write(f"cyl-render -s {seed}: no 'true camera' line in its output\n")
@@ -61,8 +66,9 @@ def drive(build, work, seed, frames):
     return obs, delta
 
 
-def residuals(path, delta):
-    """{landmark id: rows (t, du, dv, var_u, var_v, bias_var_u, bias_var_v)} and the count of gross ones."""
+def residuals(path, delta, reject=0x320):
+    """{landmark id: rows (t, du, dv, var_u, var_v, bias_var_u, bias_var_v)} and the count of gross
+    ones, over the observations with no flag bit of `reject`."""
     recs = [json.loads(line) for line in open(path)]
     rbm, why = range_bearing_model(recs[0])
     if rbm is None:
@@ -72,7 +78,7 @@ def residuals(path, delta):
     poses = {r["seq"]: (r["x_m"], r["y_m"], r["theta_rad"]) for r in recs if r["type"] == "truth_pose"}
     out, gross = {}, 0
     for o in recs:
-        if o["type"] != "obs" or o["flags"] & 0x320 or o["confidence"] < 0.5 or o["seq"] not in poses:
+        if o["type"] != "obs" or o["flags"] & reject or o["confidence"] < 0.5 or o["seq"] not in poses:
             continue
         e = rbm.eval(o["u_px"], o["v_px"], delta)
         if e is None:
@@ -105,14 +111,28 @@ def main():
     ap.add_argument("--frames", type=int, default=1000)
     ap.add_argument("--build", default="build")
     ap.add_argument("--work", default=os.path.join("build", "centroid_gm"))
+    ap.add_argument("--reject-flags", default="0x320")
+    ap.add_argument("--noise-scale", type=float, default=1.0)
     a = ap.parse_args()
     if any(s > 100 for s in a.seeds):
         ap.error("--seeds: the held-out seeds (above 100) choose nothing")
+    try:
+        reject = int(a.reject_flags, 0)
+    except ValueError:
+        ap.error(f"--reject-flags {a.reject_flags!r}: not an integer (e.g. 0x320)")
+    if not a.noise_scale > 0:
+        ap.error(f"--noise-scale {a.noise_scale}: must be > 0")
+    work, scene = a.work, None
+    if a.noise_scale != 1.0:
+        from consistency import noisy_scene
+        work = os.path.join(a.work, f"noise_x{a.noise_scale:g}")
+        os.makedirs(work, exist_ok=True)
+        scene = noisy_scene(a.build, work, a.noise_scale)
     seqs = {"u": [], "v": []}
     n_gross = n_kept = 0
     for k, seed in enumerate(a.seeds):
-        obs, delta = drive(a.build, a.work, seed, a.frames)
-        by_lm, gross = residuals(obs, delta)
+        obs, delta = drive(a.build, work, seed, a.frames, scene)
+        by_lm, gross = residuals(obs, delta, reject)
         n_gross += gross
         for rows in by_lm.values():
             r = np.array(sorted(rows))
