@@ -15,13 +15,18 @@ measured one, cyl-synth-validate --sweep-only) and the pixel-noise-only NEES. Wr
 ANEES per seed with its bounds. The last line is one JSON object.
 
 Usage: scripts/consistency.py [--quick] [--seeds 101-120] [--frames N] [--out DIR] [--build DIR]
-                              [--drives-only] [--fixed-scale S] [--noise-scale K]
+                              [--drives-only] [--fixed-scale S] [--noise-scale K] [--scene NAME|FILE]
   --quick        seeds 101-102 at 300 frames and the sweep's reduced sizes (what make test runs)
   --drives-only  the SLAM drives alone (the tuning run: --seeds 1-20 --drives-only)
   --fixed-scale  the single fixed covariance compared with (default: the one the tuning seeds chose)
   --noise-scale  render the drives with the scene's sensor noise (noise_y, noise_c) times K: the
                  built-in scene written out (cyl-render --write-scene), scaled, and rendered from
                  that file (default 1: the built-in scene itself)
+  --scene        the drives in another scene (cyl-render's built-in name, e.g. hard, or a scene
+                 file, e.g. tests/fixtures/scenes/variant.yaml), detected with the scene's camera
+                 (cyl-render --write-camera), a colour table trained on its rendered colours
+                 (cyl-render --write-table) and its landmark size; the imaging sweep stays the
+                 built-in one's (default: the built-in scene, calib_data/synthetic.cylt)
 Exit codes: 0 ran (whatever the figures), 1 a tool failed, 2 bad command line.
 """
 import argparse
@@ -73,10 +78,11 @@ def seeds_arg(s):
     return out
 
 
-def noisy_scene(build, out, k):
-    """The built-in scene with its sensor noise (noise_y, noise_c) times k, as a scene file in out."""
-    base = os.path.join(out, "scene_builtin.yaml")
-    run_process([os.path.join(build, "cyl-render"), "--write-scene", base, "-q"])
+def noisy_scene(build, out, k, scene=None):
+    """A scene (built-in name or file; default the built-in default) with its sensor noise (noise_y,
+    noise_c) times k, as a scene file in out."""
+    base = os.path.join(out, "scene_base.yaml" if scene else "scene_builtin.yaml")
+    run_process([os.path.join(build, "cyl-render"), "--write-scene", base, "-q"] + (["-S", scene] if scene else []))
     with open(base) as f:
         text = f.read()
     text, n = re.subn(r"^(\s*noise_[yc]:\s*)(\S+)\s*$", lambda m: f"{m.group(1)}{float(m.group(2)) * k!r}",
@@ -90,24 +96,53 @@ def noisy_scene(build, out, k):
     return path
 
 
-def render_and_detect(build, d, seed, frames, scene=None):
+def scene_detector(build, out, scene):
+    """What cyl detect needs for a scene other than the built-in default, made as the built-in
+    scene's are: the scene's camera (cyl-render --write-camera: the nominal calibration; each
+    drive's true camera differs by its drawn error), a colour table trained on the scene's
+    rendered colours (cyl-render --write-table, as calib_data/synthetic.cylt was), and the
+    landmarks' size (the scene's landmark_diameter_m, landmark_height_m) for every class. Returns
+    the cyl detect arguments."""
+    d = os.path.join(out, "scene_detector")
+    os.makedirs(d, exist_ok=True)
+    cam, table, written = (os.path.join(d, f) for f in ("camera.yaml", "table.cylt", "scene.yaml"))
+    render = os.path.join(build, "cyl-render")
+    run_process([render, "-S", scene, "--write-camera", cam])
+    run_process([render, "-S", scene, "--write-table", table, "-q"])
+    run_process([render, "-S", scene, "--write-scene", written, "-q"])
+    with open(written) as f:
+        text = f.read()
+    m = re.search(r"^classes:\s*\n((?:\s+-\s*\S+\s*\n)+)", text, flags=re.M)
+    size = [re.search(rf"^{k}:\s*(\S+)\s*$", text, flags=re.M) for k in ("landmark_diameter_m", "landmark_height_m")]
+    if not m or not all(size):
+        sys.stderr.write(f"{written}: no classes list or landmark_diameter_m/landmark_height_m\n")
+        sys.exit(1)
+    dia, height = (float(x.group(1)) for x in size)
+    det = ["--table", table, "--calib", cam]
+    for c in re.findall(r"-\s*(\S+)", m.group(1)):
+        det += ["--size", f"{c}={dia:g},{height:g}"]
+    return det
+
+
+def render_and_detect(build, d, seed, frames, scene=None, detector=None):
     """cyl-render a drive (a calibration error drawn once; the built-in scene, or a scene file)
-    into directory d and cyl detect it with the defaults: (the observation log's path, the
-    renderer's stderr, which names the true camera)."""
+    into directory d and cyl detect it (the built-in scene's table, camera and landmark size, or
+    `detector`'s arguments from scene_detector()): (the observation log's path, the renderer's
+    stderr, which names the true camera)."""
     os.makedirs(d, exist_ok=True)
     raw, obs = os.path.join(d, "drive.cylraw"), os.path.join(d, "observations.jsonl")
     rendered = run_process([os.path.join(build, "cyl-render"), "-o", raw, "-n", str(frames), "-s", str(seed),
                             "--calib-error", "-q"] + (["-S", scene] if scene else []))
-    run([os.path.join(build, "cyl"), "detect", raw, "--table", "calib_data/synthetic.cylt", "--calib",
-         "calib_data/synthetic_camera.yaml", "--size", "orange=0.10,0.30", "--size", "green=0.10,0.30",
-         "--out", obs, "--quiet"])
+    det = detector or ["--table", "calib_data/synthetic.cylt", "--calib", "calib_data/synthetic_camera.yaml",
+                       "--size", "orange=0.10,0.30", "--size", "green=0.10,0.30"]
+    run([os.path.join(build, "cyl"), "detect", raw] + det + ["--out", obs, "--quiet"])
     os.remove(raw)
     return obs, rendered.stderr
 
 
-def drive(build, out, seed, frames, python, scene=None):
+def drive(build, out, seed, frames, python, scene=None, detector=None):
     d = os.path.join(out, f"seed{seed}")
-    obs, _ = render_and_detect(build, d, seed, frames, scene)
+    obs, _ = render_and_detect(build, d, seed, frames, scene, detector)
     env = dict(os.environ, PYTHONPATH="slam_demo")
     run([python, "-m", "cylslam", "run", obs, "--out", os.path.join(d, "slam"), "--calib-states", "--no-plot",
          "--no-progress"], env=env)
@@ -161,21 +196,28 @@ def main():
                          "covariance (default: the one chosen on the tuning seeds 1-20)")
     ap.add_argument("--noise-scale", type=float, default=1.0,
                     help="the scene's sensor noise times K for the drives (default 1: the built-in scene)")
+    ap.add_argument("--scene", default=None,
+                    help="render the drives in this scene (a cyl-render built-in name or scene file) instead of "
+                         "the built-in default, with the scene's camera, a colour table trained on its rendered "
+                         "colours (cyl-render --write-table) and its landmark size")
     a = ap.parse_args()
     if not a.noise_scale > 0:
         ap.error(f"--noise-scale {a.noise_scale}: must be > 0")
+    if a.scene and not (a.scene in ("default", "hard", "multiband", "empty") or os.path.isfile(a.scene)):
+        ap.error(f"--scene {a.scene}: neither a built-in scene (default, hard, multiband, empty) nor a file")
     seeds = a.seeds or ([101, 102] if a.quick else list(range(101, 121)))
     frames = a.frames or (300 if a.quick else 1000)
     out = a.out or os.path.join(a.build, "consistency" + ("-quick" if a.quick else ""))
     os.makedirs(out, exist_ok=True)
     t0 = time.time()
-    scene = noisy_scene(a.build, out, a.noise_scale) if a.noise_scale != 1.0 else None
+    detector = scene_detector(a.build, out, a.scene) if a.scene else None
+    scene = noisy_scene(a.build, out, a.noise_scale, a.scene) if a.noise_scale != 1.0 else a.scene
     rows = []
     print("joint ANEES (judged) and the mean of the marginal NEES (marg.)")
     print(f"{'seed':>5} {'lm ANEES':>9} {'(marg.)':>8} {'bounds':>11} {'pose ANEES':>10} {'(marg.)':>8} {'bounds':>11} "
           f"{'ATE m':>8} {'fixed m':>8} {'dead-r m':>8} {'assoc':>5} {'mapped':>7}")
     for i, seed in enumerate(seeds):
-        s = drive(a.build, out, seed, frames, a.python, scene)
+        s = drive(a.build, out, seed, frames, a.python, scene, detector)
         r = {"seed": seed, "anees_landmarks": s.get("anees_landmarks_joint"),
              "anees_landmarks_bounds95": s.get("anees_landmarks_joint_bounds95"),
              "anees_poses": s.get("anees_poses_joint"), "anees_poses_bounds95": s.get("anees_poses_joint_bounds95"),
@@ -225,7 +267,7 @@ def main():
           f"(marginal means: {lm_in_m} and {pose_in_m}); ATE better than the best fixed covariance on {better} of {n}")
 
     res = {
-        "seeds": seeds, "frames": frames, "noise_scale": a.noise_scale,
+        "seeds": seeds, "frames": frames, "noise_scale": a.noise_scale, "scene": a.scene or "default (built-in table)",
         "seeds_landmark_anees_in_bounds": round(lm_in / n, 3),
         "seeds_pose_anees_in_bounds": round(pose_in / n, 3),
         "seeds_landmark_anees_marginal_in_bounds": round(lm_in_m / n, 3),

@@ -6,7 +6,10 @@
 # expected, no floor), the image estimator's ratio to the measured variance within 0.5-1.5 over
 # the sweep, every seed's SLAM run producing both ANEES figures with their bounds and the fixed
 # covariance's ATE at every scale of its grid (the best of them the one reported). The full
-# figures (20 seeds) are make consistency's. GoogleTest-style lines.
+# figures (20 seeds) are make consistency's. Then one short drive in another scene (--scene with
+# tests/fixtures/scenes/variant.yaml): the camera, table and landmark size come from that scene
+# (its 8 deg tilt and 0.25 m camera height above the landmarks' middle in the camera file the
+# detector used) and the SLAM run gives both ANEES. GoogleTest-style lines.
 #   test_consistency_quick.sh BUILD_DIR
 set -u
 B=$1
@@ -40,5 +43,29 @@ for k in ("seeds_landmark_anees_in_bounds", "seeds_pose_anees_in_bounds", "ate_b
 print("; ".join(bad))
 PY
 )
-if [ -z "$msg" ]; then echo "[       OK ] consistency.quick ($(tail -1 "$T/log" | cut -c1-200))"; echo "[  PASSED  ] 1 tests."
+if [ -z "$msg" ]; then echo "[       OK ] consistency.quick ($(tail -1 "$T/log" | cut -c1-200))"
 else echo "  $msg"; echo "[  FAILED  ] consistency.quick"; exit 1; fi
+
+echo "[ RUN      ] consistency.scene_file"
+if ! .venv/bin/python scripts/consistency.py --scene tests/fixtures/scenes/variant.yaml --seeds 101 --frames 300 \
+     --drives-only --build "$B" --out "$T/s" >"$T/slog" 2>"$T/serr"; then
+  echo "  consistency.py --scene failed: $(tail -5 "$T/serr")"; echo "[  FAILED  ] consistency.scene_file"; exit 1
+fi
+msg=$(.venv/bin/python - "$T/slog" "$T/s" <<'PY'
+import json, os, re, sys
+r = json.loads(open(sys.argv[1]).read().strip().splitlines()[-1])
+d = os.path.join(sys.argv[2], "scene_detector")
+bad = []
+if r["scene"] != "tests/fixtures/scenes/variant.yaml": bad.append(f"scene {r['scene']}")
+cam = open(os.path.join(d, "camera.yaml")).read()
+tilt = float(re.search(r"^mount_tilt_deg:\s*(\S+)", cam, re.M).group(1))
+height = float(re.search(r"^mount_height_m:\s*(\S+)", cam, re.M).group(1))
+if abs(tilt - 8.0) > 1e-9 or abs(height - 0.25) > 1e-9: bad.append(f"camera tilt {tilt} deg, height {height} m")
+if not os.path.getsize(os.path.join(d, "table.cylt")) > 0: bad.append("no table")
+if not (isinstance(r["anees_poses"][0], float) and isinstance(r["anees_landmarks"][0], float)):
+    bad.append(f"ANEES {r['anees_landmarks']} {r['anees_poses']}")
+print("; ".join(bad))
+PY
+)
+if [ -z "$msg" ]; then echo "[       OK ] consistency.scene_file ($(tail -1 "$T/slog" | cut -c1-160))"; echo "[  PASSED  ] 2 tests."
+else echo "  $msg"; echo "[  FAILED  ] consistency.scene_file"; exit 1; fi
