@@ -86,6 +86,11 @@ const char *kUsage =
     "  --partial-aspect-min F   flag an observation 0x800 (partly hidden) when its blob's\n"
     "                       width-to-height ratio is under F, or over 1/F, times a whole\n"
     "                       landmark's there (default 0.8; 0: off; docs/uncertainty.md)\n"
+    "  --partial-offset-max F   ... and, where its range is accurate, when its centroid lies\n"
+    "                       more than F of the box's width from the box's middle column (a side\n"
+    "                       not classified; default 0.04; 0: off)\n"
+    "  --partial-area-min F     ... and when its blob's area is under F times the area of a\n"
+    "                       whole landmark's silhouette there (default 0: off)\n"
     "  --overlay DIR|FILE.avi   write overlay images (PNG per frame) or a video\n"
     "  --show               show the overlay in a window (needs a display; q or Esc stops)\n"
     "clutter rejection (per class with CLASS=VALUE, every class with VALUE; the command line\n"
@@ -118,6 +123,8 @@ struct Args {
     std::vector<std::string> sizes, controls, min_area, max_area, merge_gap, size_gate;
     double var_floor_px2 = 0.0;
     double partial_aspect_min = -1.0;   // < 0: libcyl's default
+    double partial_area_min = -1.0;     // < 0: libcyl's default
+    double partial_offset_max = -1.0;   // < 0: libcyl's default
     std::string silhouette_sigma;
     uint64_t max_frames = 0;
     bool show = false, quiet = false, fixed_exposure = false, lenient = false;
@@ -179,6 +186,16 @@ Args parse(int argc, char **argv)
         else if (s == "--centroid-var-floor") {
             a.var_floor_px2 = parse_double(s, val(s));
             if (a.var_floor_px2 < 0) usage_error("--centroid-var-floor: must be >= 0 px^2");
+        }
+        else if (s == "--partial-offset-max") {
+            a.partial_offset_max = parse_double(s, val(s));
+            if (!(a.partial_offset_max >= 0 && a.partial_offset_max <= 1))
+                usage_error("--partial-offset-max: must be 0..1 (0: off)");
+        }
+        else if (s == "--partial-area-min") {
+            a.partial_area_min = parse_double(s, val(s));
+            if (!(a.partial_area_min >= 0 && a.partial_area_min <= 1))
+                usage_error("--partial-area-min: must be 0..1 (0: off)");
         }
         else if (s == "--partial-aspect-min") {
             a.partial_aspect_min = parse_double(s, val(s));
@@ -369,6 +386,8 @@ int cmd_detect(const Args &a)
     }
     cfg.observe.min_var_px2 = a.var_floor_px2;
     if (a.partial_aspect_min >= 0) cfg.observe.partial_aspect_min = a.partial_aspect_min;
+    if (a.partial_area_min >= 0) cfg.observe.partial_area_min = a.partial_area_min;
+    if (a.partial_offset_max >= 0) cfg.observe.partial_offset_max = a.partial_offset_max;
     cyl_camera cam;
     if (!a.calib.empty()) {
         CameraCalibration cal = load_mounted_camera_calibration(a.calib, a.lenient);

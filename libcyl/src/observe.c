@@ -19,6 +19,8 @@ cyl_observe_params cyl_observe_params_default(void)
     p.min_var_px2 = 0.0;
     p.nonlinear_rel_sigma = 0.055;
     p.partial_aspect_min = CYL_PARTIAL_ASPECT_MIN_DEFAULT;
+    p.partial_area_min = CYL_PARTIAL_AREA_MIN_DEFAULT;
+    p.partial_offset_max = CYL_PARTIAL_OFFSET_MAX_DEFAULT;
     p.silhouette_rel_sigma = 0.25;
     p.silhouette_sigma_u_px = 0.25;
     p.silhouette_sigma_v_px = 0.25;
@@ -92,7 +94,7 @@ static cyl_status bias_of(const cyl_camera *cam, const cyl_observe_params *p, co
  * 0.003 px). The offset's variance is added to the centroid's. On any failure the uncorrected
  * result stays. */
 static void correct_silhouette(cyl_observation *o, const cyl_camera *cam, const cyl_observe_params *p,
-                               const shape_ref *sh, cyl_rb_result *rb)
+                               const shape_ref *sh, cyl_rb_result *rb, double *sil_area_px2)
 {
     const double var_cu = o->var_u_px2, var_cv = o->var_v_px2;   /* the centroid's own */
     int it;
@@ -115,6 +117,7 @@ static void correct_silhouette(cyl_observation *o, const cyl_camera *cam, const 
         o->bias_v_px = sb.dv_px;
         o->bias_var_u_px2 = sb.var_u_px2;
         o->bias_var_v_px2 = sb.var_v_px2;
+        *sil_area_px2 = sb.area_px2;
     }
 }
 
@@ -153,17 +156,18 @@ static void calib_share(cyl_observation *o, const cyl_camera *cam, const cyl_rb_
 
 /* From the measurement point's centroid and variances (o->centroid_*, o->var_*) and box (w_px,
  * h_px): the silhouette correction, range and bearing with their covariances, the calibration's
- * share, the non-linearity flag and the confidence against the expected box of conf_size. */
+ * share, the non-linearity flag, the confidence against the expected box of conf_size, and (a
+ * single blob's, blob_area_px2 > 0) its area against the silhouette's. */
 static void locate(cyl_observation *o, const cyl_camera *cam, const cyl_observe_params *p, const shape_ref *sh,
-                   const cyl_landmark_size *conf_size, uint32_t blob_flags)
+                   const cyl_landmark_size *conf_size, uint32_t blob_flags, double blob_area_px2, double box_mid_u_px)
 {
     cyl_rb_result rb;
     cyl_status st = cyl_rb_compute(cam, p->model, o->u_px, o->v_px, o->var_u_px2, o->var_v_px2, 0.0, &rb);
-    double su, sv;
+    double su, sv, sil_area_px2 = 0.0;
     abs_sigmas(p, sh, &su, &sv);
     if (st == CYL_OK && p->silhouette_rel_sigma >= 0.0 && su >= 0.0 && sv >= 0.0 && !(o->flags & CYL_OBS_CUT) &&
         (sh->model || (sh->size->diameter_m > 0.0 && sh->size->height_m > 0.0)))
-        correct_silhouette(o, cam, p, sh, &rb);
+        correct_silhouette(o, cam, p, sh, &rb, &sil_area_px2);
     if (st == CYL_ERR_NO_RANGE) {
         o->flags |= CYL_OBS_NO_RANGE;
         o->bearing_rad = rb.bearing_rad;
@@ -194,6 +198,18 @@ static void locate(cyl_observation *o, const cyl_camera *cam, const cyl_observe_
             if (p->partial_aspect_min > 0.0 &&
                 (o->aspect_rel < p->partial_aspect_min || o->aspect_rel * p->partial_aspect_min > 1.0))
                 o->flags |= CYL_OBS_PARTIAL;
+            /* both judged only where the range is accurate (as on the views they were chosen on):
+             * the silhouette's area goes as 1/range^2, so a range off by sigma_r/r moves area_rel
+             * by about 2 sigma_r/r; and a far landmark's narrow box is rounded by a large share
+             * of its width */
+            if (blob_area_px2 > 0.0 && sil_area_px2 > 0.0) {
+                o->area_rel = blob_area_px2 / sil_area_px2;
+                o->offset_rel = (o->u_px - box_mid_u_px) / o->w_px;
+                if (!(o->flags & CYL_OBS_NONLINEAR) &&
+                    ((p->partial_area_min > 0.0 && o->area_rel < p->partial_area_min) ||
+                     (p->partial_offset_max > 0.0 && fabs(o->offset_rel) > p->partial_offset_max)))
+                    o->flags |= CYL_OBS_PARTIAL;
+            }
         } else {
             o->flags |= CYL_OBS_NO_SIZE;
         }
@@ -204,9 +220,10 @@ static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *c
                                 size_t work_size, uint32_t cap, const void *out, const uint32_t *n_out);
 
 /* A blob's centroid and its variance by the chosen estimator; with params.subpixel the centroid
- * is moved to the one with sub-pixel edges, whose shift goes to *du, *dv (else 0). */
+ * is moved to the one with sub-pixel edges, whose shift goes to *du, *dv (else 0). *area_px2: the
+ * blob's area, px^2 (with its edges moved, when they are). */
 static cyl_status blob_noise(const cyl_segmentation *seg, const cyl_blob *b, const cyl_observe_params *p, void *work,
-                             size_t work_size, cyl_centroid_noise *cn, double *du, double *dv)
+                             size_t work_size, cyl_centroid_noise *cn, double *du, double *dv, double *area_px2)
 {
 #if CYL_CONFIG_IMAGE_ESTIMATOR
     cyl_status st = p->estimator == CYL_NOISE_IMAGE ? cyl_noise_blob_image(seg, b, p->image, p->table, &p->image_noise, cn)
@@ -216,6 +233,7 @@ static cyl_status blob_noise(const cyl_segmentation *seg, const cyl_blob *b, con
                                                      : cyl_noise_blob(seg, b, p->estimator, work, work_size, cn);
 #endif
     *du = *dv = 0.0;
+    *area_px2 = st == CYL_OK ? (double)cn->n * (double)seg->x_step * (double)seg->y_step : 0.0;
 #if CYL_CONFIG_SUBPIXEL
     if (st == CYL_OK && p->subpixel) {
         cyl_subpixel_result r;
@@ -225,6 +243,7 @@ static cyl_status blob_noise(const cyl_segmentation *seg, const cyl_blob *b, con
             *dv = r.cy_px - cn->cy_px;
             cn->cx_px = r.cx_px;
             cn->cy_px = r.cy_px;
+            *area_px2 = r.area_px2;
         } else if (s2 != CYL_ERR_EMPTY) {
             return s2;
         }
@@ -248,11 +267,11 @@ cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
         const cyl_blob *b = &seg->blobs[bi];
         cyl_observation *o;
         cyl_centroid_noise cn;
-        double du, dv;
+        double du, dv, area_px2;
         if (b->cls >= CYL_MAX_CLASSES || !(p->class_mask & (1u << b->cls))) continue;
         if (b->area < p->min_area) continue;
         if (n == cap) { ret = CYL_TRUNCATED; break; }
-        st = blob_noise(seg, b, p, work, work_size, &cn, &du, &dv);
+        st = blob_noise(seg, b, p, work, work_size, &cn, &du, &dv, &area_px2);
         if (st == CYL_ERR_EMPTY) continue;
         if (st != CYL_OK) return st;
         o = &out[n++];
@@ -276,7 +295,7 @@ cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
             shape_ref sh;
             memset(&sh, 0, sizeof sh);
             sh.size = &p->size[b->cls];
-            locate(o, cam, p, &sh, &p->size[b->cls], b->flags);
+            locate(o, cam, p, &sh, &p->size[b->cls], b->flags, area_px2, 0.5 * ((double)b->x0 + (double)b->x1));
         }
     }
     *n_out = n;
@@ -339,11 +358,11 @@ cyl_status cyl_observe_groups(const cyl_segmentation *seg, const cyl_group *grou
             const uint32_t bi = g->blob[k];
             const cyl_blob *b;
             cyl_centroid_noise cn;
-            double du, dv;
+            double du, dv, area_px2;
             if (bi == CYL_NONE) continue;
             if (bi >= seg->n_blobs) return CYL_ERR_ARG;
             b = &seg->blobs[bi];
-            st = blob_noise(seg, b, p, work, work_size, &cn, &du, &dv);
+            st = blob_noise(seg, b, p, work, work_size, &cn, &du, &dv, &area_px2);
             if (st == CYL_ERR_EMPTY) continue;
             if (st != CYL_OK) return st;
             if (first == CYL_NONE) first = bi;
@@ -408,7 +427,7 @@ cyl_status cyl_observe_groups(const cyl_segmentation *seg, const cyl_group *grou
             sh.band_mask = mask;
             whole.diameter_m = d_top > m->diameter_bottom_m ? d_top : m->diameter_bottom_m;
             whole.height_m = total_h;
-            locate(o, &cam_ref, p, &sh, &whole, blob_flags);
+            locate(o, &cam_ref, p, &sh, &whole, blob_flags, 0.0, 0.0);   /* no area or offset check: bands */
         }
     }
     *n_out = n;

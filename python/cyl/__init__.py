@@ -263,6 +263,9 @@ def observe(table: Table, frame: np.ndarray, fmt: str, camera: Camera,
         })
         if o.aspect_rel > 0.0:
             out[-1]["aspect_rel"] = o.aspect_rel
+        if o.area_rel > 0.0:
+            out[-1]["area_rel"] = o.area_rel
+            out[-1]["offset_rel"] = o.offset_rel
         if o.subpixel_du_px != 0.0 or o.subpixel_dv_px != 0.0:
             out[-1]["subpixel_shift_px"] = [o.subpixel_du_px, o.subpixel_dv_px]
     del keep

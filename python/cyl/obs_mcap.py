@@ -51,6 +51,8 @@ SCHEMAS: Dict[str, dict] = {
         "u_px": _n("px, measurement point column"), "v_px": _n("px, row"),
         "var_u_px2": _n("px^2"), "var_v_px2": _n("px^2"), "area_px": {"type": "integer"},
         "aspect_rel": _n("blob width/height over the whole landmark's, < 1 a side hidden"),
+        "area_rel": _n("blob area over the whole landmark's silhouette's, < 1 parts not classified"),
+        "offset_rel": _n("(u_px - box middle column) / box width, away from 0 a side not classified"),
         "flags": {"type": "integer"}, "bbox_px": {"type": "array", "items": {"type": "integer"},
                                                   "description": "x0 y0 x1 y1, px, inclusive"},
         "jac_calib": {"type": "array", "items": NUM}, "cov_frame": {"type": "array", "items": NUM},

@@ -156,6 +156,10 @@ def test_observations_equal_the_c_tools(tmp_path):
             assert g["class"] == c["class"] and g["bbox_px"] == c["bbox_px"] and g["flags"] == c["flags"]
             for k in ("range_m", "bearing_rad", "u_px", "v_px", "var_u_px2", "var_v_px2", "confidence", "aspect_rel"):
                 assert g[k] == pytest.approx(c[k], rel=1e-8, abs=1e-12), (seq, k)
+            assert ("area_rel" in g) == ("area_rel" in c) and ("offset_rel" in g) == ("offset_rel" in c), seq
+            for k in ("area_rel", "offset_rel"):
+                if k in c:
+                    assert g[k] == pytest.approx(c[k], rel=1e-8, abs=1e-12), (seq, k)
             assert g["cov_rb"][0][0] == pytest.approx(c["cov_rr"], rel=1e-8)
             assert g["cov_rb"][1][1] == pytest.approx(c["cov_bb"], rel=1e-8)
             assert g["bias_var_px2"] == pytest.approx(c["bias_var_px2"], rel=1e-8)

@@ -12,6 +12,7 @@
 
 #include "cyl/observe.h"
 #include "cyl/colortable.h"
+#include "cyl/silhouette.h"
 #include "cylinder_ref.h"
 #include "rng.h"
 #include "synth_frames.h"
@@ -185,6 +186,21 @@ static void test_flags(void **st)
 }
 
 /* End to end: a rectangle drawn in a synthetic frame, segmented by cyl_segment, observed. */
+/* the box, px (inclusive), of a landmark 0.16 m wide and 0.30 m tall at robot-frame (1.5, 0.2) m */
+static void landmark_box(const cyl_camera *cam, int *x0, int *y0, int *x1, int *y1)
+{
+    double u, v, w, hh;
+    cyl_rb_result r;
+    assert_int_equal(cyl_rb_project(cam, 1.5, 0.2, &u, &v), CYL_OK);
+    assert_int_equal(cyl_range_bearing(cam, CYL_GEOM_EXACT, u, v, 0, 0, 0, &r), CYL_OK);
+    w = cam->fx_px * 0.16 / r.depth_m;
+    hh = cam->fy_px * 0.30 / r.depth_m;
+    *x0 = (int)lround(u - w / 2 + 0.5);
+    *y0 = (int)lround(v - hh / 2 + 0.5);
+    *x1 = (int)lround(u + w / 2 - 0.5);
+    *y1 = (int)lround(v + hh / 2 - 0.5);
+}
+
 /* aspect_rel and CYL_OBS_PARTIAL: a whole landmark's box has the expected width-to-height ratio
  * (aspect_rel = (w/h) / (w_est/h_est), near 1 up to the rounding of its corners); the same landmark
  * with a side hidden (60% of its width seen) or its top hidden (60% of its height seen) is flagged,
@@ -195,23 +211,14 @@ static void test_partial(void **st)
     cyl_observe_params p = cyl_observe_params_default();
     cyl_observation obs[8];
     uint32_t n;
-    double u, v, w, hh;
     int x0, y0, x1, y1, i;
-    cyl_rb_result r;
     (void)st;
     unc_paper_camera(&cam);
     assert_true(p.partial_aspect_min > 0.5 && p.partial_aspect_min < 1.0);
     p.silhouette_rel_sigma = -1;
     p.size[0].diameter_m = 0.16;
     p.size[0].height_m = 0.30;
-    assert_int_equal(cyl_rb_project(&cam, 1.5, 0.2, &u, &v), CYL_OK);
-    assert_int_equal(cyl_range_bearing(&cam, CYL_GEOM_EXACT, u, v, 0, 0, 0, &r), CYL_OK);
-    w = cam.fx_px * 0.16 / r.depth_m;
-    hh = cam.fy_px * 0.30 / r.depth_m;
-    x0 = (int)lround(u - w / 2 + 0.5);
-    y0 = (int)lround(v - hh / 2 + 0.5);
-    x1 = (int)lround(u + w / 2 - 0.5);
-    y1 = (int)lround(v + hh / 2 - 0.5);
+    landmark_box(&cam, &x0, &y0, &x1, &y1);
     hs_init(&H);
     hs_rect(&H, 0, x0, y0, x1, y1);                                   /* whole */
     hs_rect(&H, 0, x0 + 200, y0, x0 + 200 + (int)lround(0.6 * (x1 - x0 + 1)) - 1, y1);  /* a side hidden */
@@ -236,6 +243,100 @@ static void test_partial(void **st)
     p.partial_aspect_min = 0.0;
     assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
     for (i = 0; i < 3; i++) assert_false(obs[i].flags & CYL_OBS_PARTIAL);
+}
+
+/* area_rel and CYL_OBS_PARTIAL by area: the blob's area over the whole landmark's silhouette at
+ * its place. Two blobs with the same (whole) box: a full rectangle, and one whose middle third of
+ * rows keeps only its left 40% (a side of the landmark not classified there). */
+static void hs_notched(hseg *h, uint8_t cls, int x0, int y0, int x1, int y1, int ya, int yb, int keep)
+{
+    cyl_blob *b;
+    int y;
+    hs_rect(h, cls, x0, y0, x1, y1);
+    b = &h->blobs[h->seg.n_blobs - 1];
+    for (y = ya; y <= yb; y++) {
+        cyl_run *r = &h->runs[b->first_run + (uint32_t)(y - y0)];
+        b->area -= r->width - (uint32_t)keep;
+        r->width = (uint16_t)keep;
+    }
+}
+
+static void test_partial_area(void **st)
+{
+    cyl_camera cam;
+    cyl_observe_params p = cyl_observe_params_default();
+    cyl_observation obs[8];
+    cyl_silhouette_bias sb;
+    uint32_t n;
+    double thr;
+    int x0, y0, x1, y1, i, third;
+    (void)st;
+    unc_paper_camera(&cam);
+    assert_true(p.partial_area_min == CYL_PARTIAL_AREA_MIN_DEFAULT);
+    assert_true(p.partial_offset_max == CYL_PARTIAL_OFFSET_MAX_DEFAULT);
+    p.partial_offset_max = 0.0;   /* the area alone first */
+    p.size[0].diameter_m = 0.16;
+    p.size[0].height_m = 0.30;
+    landmark_box(&cam, &x0, &y0, &x1, &y1);
+    third = (y1 - y0 + 1) / 3;
+    hs_init(&H);
+    hs_rect(&H, 0, x0, y0, x1, y1);
+    hs_notched(&H, 0, x0 + 200, y0, x1 + 200, y1, y0 + third, y0 + 2 * third - 1, (int)lround(0.4 * (x1 - x0 + 1)));
+    p.partial_area_min = 0.0;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_int_equal(n, 2);
+    for (i = 0; i < 2; i++) {
+        /* the definition: the blob's samples over the silhouette's area where it was measured (the
+         * silhouette is taken at the point of the correction's last pass, which differs from the
+         * final one by well under a pixel: 0.5%) */
+        assert_int_equal(cyl_silhouette_bias_at(&cam, obs[i].x_m, obs[i].y_m, &p.size[0], p.silhouette_rel_sigma, 0.0, &sb),
+                         CYL_OK);
+        assert_true(fabs(obs[i].area_rel - (double)obs[i].area / sb.area_px2) < 5e-3 * obs[i].area_rel);
+        assert_false(obs[i].flags & CYL_OBS_PARTIAL);   /* the box is whole: aspect_rel alone does not flag it */
+    }
+    /* a rectangle of the landmark's diameter x height: the silhouette adds the ends' ellipses */
+    assert_true(obs[0].area_rel > 0.9 && obs[0].area_rel < 1.0);
+    /* a third of the rows lost 60% of their width: a fifth of the area */
+    assert_true(fabs(obs[1].area_rel / obs[0].area_rel - (double)obs[1].area / (double)obs[0].area) < 0.01);
+    assert_true(obs[1].area_rel < 0.85 * obs[0].area_rel);
+    thr = 0.5 * (obs[0].area_rel + obs[1].area_rel);
+    p.partial_area_min = thr;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_false(obs[0].flags & CYL_OBS_PARTIAL);
+    assert_true(obs[1].flags & CYL_OBS_PARTIAL);
+    /* where the range is not accurate (every observation CYL_OBS_NONLINEAR here) the area is not judged */
+    p.nonlinear_rel_sigma = 1e-9;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(obs[1].flags & CYL_OBS_NONLINEAR);
+    assert_false(obs[1].flags & CYL_OBS_PARTIAL);
+    assert_true(obs[1].area_rel > 0.0);
+    /* offset_rel: the definition from the observation's own fields, the whole rectangle near its
+     * box's middle, the notched one (its middle rows' right 60% missing) moved left by about
+     * a fifth of the missing share: flagged by the offset alone at the default threshold */
+    p.nonlinear_rel_sigma = 0.055;
+    p.partial_area_min = 0.0;
+    p.partial_offset_max = CYL_PARTIAL_OFFSET_MAX_DEFAULT;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(fabs(obs[0].offset_rel - (obs[0].u_px - 0.5 * (x0 + x1)) / obs[0].w_px) < 1e-12);
+    assert_true(fabs(obs[1].offset_rel - (obs[1].u_px - 0.5 * (x0 + 200 + x1 + 200)) / obs[1].w_px) < 1e-12);
+    assert_true(fabs(obs[0].offset_rel) < 0.02);
+    assert_false(obs[0].flags & CYL_OBS_PARTIAL);
+    {
+        /* the notch removes 0.6 w from a third of the rows, centred 0.2 w right of the middle */
+        double lost = 0.6 * (1.0 / 3.0), shift = -lost * 0.2 / (1.0 - lost);
+        assert_true(fabs(obs[1].offset_rel - obs[0].offset_rel - shift) < 0.01);
+    }
+    assert_true(obs[1].flags & CYL_OBS_PARTIAL);
+    p.partial_offset_max = 0.0;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_false(obs[1].flags & CYL_OBS_PARTIAL);
+    /* no silhouette (no correction): no area_rel, no flag */
+    p.partial_area_min = thr;
+    p.partial_offset_max = CYL_PARTIAL_OFFSET_MAX_DEFAULT;
+    p.silhouette_rel_sigma = -1;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(obs[1].area_rel == 0.0);
+    assert_false(obs[1].flags & CYL_OBS_PARTIAL);
 }
 
 static void test_end_to_end(void **st)
@@ -598,6 +699,7 @@ int main(void)
         cmocka_unit_test(test_silhouette_corrected),
         cmocka_unit_test(test_flags),
         cmocka_unit_test(test_partial),
+        cmocka_unit_test(test_partial_area),
         cmocka_unit_test(test_end_to_end),
         cmocka_unit_test(test_groups_end_to_end),
     };

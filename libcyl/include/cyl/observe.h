@@ -51,13 +51,29 @@ extern "C" {
                                        behind something), shorter (top or bottom hidden) or wider
                                        (run into something of its colour): the centroid, bearing
                                        included, is off by a share of the missing or extra part,
-                                       far beyond its variance */
+                                       far beyond its variance; or, where the range is accurate
+                                       (no CYL_OBS_NONLINEAR), |offset_rel| above
+                                       params.partial_offset_max or area_rel below
+                                       params.partial_area_min: the box is whole but the blob is
+                                       not (a lit or shaded side, or patches, left out of the
+                                       class), with the same effect */
 
 /* Default of cyl_observe_params.partial_aspect_min: chosen on the synthetic scene's tuning drives
  * (seeds 1-20, and 1-6 at twice and half the sensor noise; docs/uncertainty.md, "Partly hidden
  * landmarks"). A whole landmark's aspect_rel lies within 0.805-1.075 on 98% of the views of
  * seeds 1-20. */
 #define CYL_PARTIAL_ASPECT_MIN_DEFAULT 0.8
+
+/* Default of cyl_observe_params.partial_offset_max: on the synthetic scene's tuning drives (seeds
+ * 1-20, and 1-6 at twice and half the sensor noise) |offset_rel| of the views a back end uses whole
+ * is below 0.0403 on 99% of them (docs/uncertainty.md, "Blobs with a side missing"). */
+#define CYL_PARTIAL_OFFSET_MAX_DEFAULT 0.04
+
+/* Default of cyl_observe_params.partial_area_min: 0 (off). On the same drives area_rel is above
+ * 0.775 on 99% of the views at the nominal sensor noise, but at twice the noise a whole landmark's
+ * blob breaks into pieces and keeps 0.75 of its area (median): no threshold separates that from a
+ * side missing, which offset_rel does. */
+#define CYL_PARTIAL_AREA_MIN_DEFAULT 0.0
 
 /* Calibration parameters in cyl_observation.jac_calib: fx fy cx cy tilt yaw h s. Their prior
  * covariance is cyl_calib_cov(). */
@@ -77,6 +93,12 @@ typedef struct cyl_observe_params {
     double partial_aspect_min;                  /* CYL_OBS_PARTIAL when aspect_rel is below this or
                                                    above its inverse (default CYL_PARTIAL_ASPECT_MIN_DEFAULT;
                                                    <= 0 disables) */
+    double partial_offset_max;                  /* CYL_OBS_PARTIAL when |offset_rel| is above this
+                                                   (default CYL_PARTIAL_OFFSET_MAX_DEFAULT; <= 0
+                                                   disables) */
+    double partial_area_min;                    /* CYL_OBS_PARTIAL when area_rel is below this
+                                                   (default CYL_PARTIAL_AREA_MIN_DEFAULT: off; <= 0
+                                                   disables) */
     cyl_landmark_size size[CYL_MAX_CLASSES];    /* physical size of each class's landmarks, m
                                                    (default 0 = unknown) */
     /* CYL_NOISE_IMAGE and subpixel: the frame and colour table seg was made from, and the image
@@ -147,6 +169,18 @@ typedef struct cyl_observation {
                                    it); about 1 for a whole landmark, < 1 when a side is hidden,
                                    > 1 when the top or bottom is; 0 when unknown (no size,
                                    no range) */
+    double area_rel;            /* the blob's area (with its edges moved, when they are: the
+                                   sub-pixel edges' area) over the area of the whole landmark's
+                                   silhouette at the measured place (cyl_silhouette_bias.area_px2),
+                                   unitless: about 1 for a whole landmark, less when parts of it
+                                   were not classified; 0 when unknown (no size, no range, cut by
+                                   the border, a group of bands) */
+    double offset_rel;          /* (u_px - the blob box's middle column) / w_px, unitless: a whole
+                                   landmark's silhouette is symmetric about its axis, so its
+                                   measurement point lies at the box's middle (within 0.04 of the
+                                   width on 99% of the synthetic drives' views); a side missing
+                                   moves the centroid by about half the missing share of the width
+                                   while the box stays; 0 when unknown (as area_rel) */
     /* The calibration's share, for back ends that estimate the calibration error as a state:
      * it is constant during a run, so per-observation factors with cov_rb are not independent
      * (docs/uncertainty.md, "Constant calibration errors"). */
