@@ -91,6 +91,9 @@ const char *kUsage =
     "                       not classified; default 0.04; 0: off)\n"
     "  --partial-area-min F     ... and when its blob's area is under F times the area of a\n"
     "                       whole landmark's silhouette there (default 0: off)\n"
+    "  --subpixel-rel-sigma R   uncertainty of the sub-pixel edges' shift of a blob's centroid,\n"
+    "                       as a share of the shift, added to its bias variance (default 0:\n"
+    "                       none; docs/uncertainty.md, \"Other scenes\")\n"
     "  --overlay DIR|FILE.avi   write overlay images (PNG per frame) or a video\n"
     "  --show               show the overlay in a window (needs a display; q or Esc stops)\n"
     "clutter rejection (per class with CLASS=VALUE, every class with VALUE; the command line\n"
@@ -125,6 +128,7 @@ struct Args {
     double partial_aspect_min = -1.0;   // < 0: libcyl's default
     double partial_area_min = -1.0;     // < 0: libcyl's default
     double partial_offset_max = -1.0;   // < 0: libcyl's default
+    double subpixel_rel_sigma = -1.0;   // < 0: libcyl's default
     std::string silhouette_sigma;
     uint64_t max_frames = 0;
     bool show = false, quiet = false, fixed_exposure = false, lenient = false;
@@ -191,6 +195,11 @@ Args parse(int argc, char **argv)
             a.partial_offset_max = parse_double(s, val(s));
             if (!(a.partial_offset_max >= 0 && a.partial_offset_max <= 1))
                 usage_error("--partial-offset-max: must be 0..1 (0: off)");
+        }
+        else if (s == "--subpixel-rel-sigma") {
+            a.subpixel_rel_sigma = parse_double(s, val(s));
+            if (!(a.subpixel_rel_sigma >= 0 && a.subpixel_rel_sigma <= 10))
+                usage_error("--subpixel-rel-sigma: must be 0..10 (0: none)");
         }
         else if (s == "--partial-area-min") {
             a.partial_area_min = parse_double(s, val(s));
@@ -388,6 +397,7 @@ int cmd_detect(const Args &a)
     if (a.partial_aspect_min >= 0) cfg.observe.partial_aspect_min = a.partial_aspect_min;
     if (a.partial_area_min >= 0) cfg.observe.partial_area_min = a.partial_area_min;
     if (a.partial_offset_max >= 0) cfg.observe.partial_offset_max = a.partial_offset_max;
+    if (a.subpixel_rel_sigma >= 0) cfg.observe.subpixel_rel_sigma = a.subpixel_rel_sigma;
     cyl_camera cam;
     if (!a.calib.empty()) {
         CameraCalibration cal = load_mounted_camera_calibration(a.calib, a.lenient);

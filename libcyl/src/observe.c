@@ -29,6 +29,7 @@ cyl_observe_params cyl_observe_params_default(void)
     p.image_noise = cyl_noise_image_params_default();
     p.subpixel = 0;
     p.subpixel_params = cyl_subpixel_params_default();
+    p.subpixel_rel_sigma = 0.0;
     return p;
 }
 
@@ -91,8 +92,9 @@ static cyl_status bias_of(const cyl_camera *cam, const cyl_observe_params *p, co
 /* The silhouette's geometric bias (cyl/silhouette.h) taken out of the measurement point: the
  * offset at the landmark's position, which comes from the point itself, so twice (on the synthetic
  * camera at 0.8-4 m one pass leaves the point up to 0.081 px from the image of the centre, two
- * 0.003 px). The offset's variance is added to the centroid's. On any failure the uncorrected
- * result stays. */
+ * 0.003 px). The offset's variance is added to the centroid's, and for a single blob so is the
+ * sub-pixel edges' shift's (o->subpixel_du_px, dv: a correction too, with subpixel_rel_sigma of
+ * itself as its uncertainty). On any failure the uncorrected result stays. */
 static void correct_silhouette(cyl_observation *o, const cyl_camera *cam, const cyl_observe_params *p,
                                const shape_ref *sh, cyl_rb_result *rb, double *sil_area_px2)
 {
@@ -103,6 +105,11 @@ static void correct_silhouette(cyl_observation *o, const cyl_camera *cam, const 
         cyl_rb_result r2;
         double u, v, vu, vv;
         if (bias_of(cam, p, sh, rb->x_m, rb->y_m, &sb) != CYL_OK) return;
+        if (!sh->model && p->subpixel_rel_sigma > 0.0) {
+            const double su = p->subpixel_rel_sigma * o->subpixel_du_px, sv = p->subpixel_rel_sigma * o->subpixel_dv_px;
+            sb.var_u_px2 += su * su;
+            sb.var_v_px2 += sv * sv;
+        }
         u = o->centroid_u_px - sb.du_px;
         v = o->centroid_v_px - sb.dv_px;
         vu = var_cu + sb.var_u_px2;
@@ -321,6 +328,7 @@ static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *c
         return CYL_ERR_ARG;
     /* a sigma of the silhouette's offset may be negative (no correction) but not infinite or NaN */
     if (!isfinite(p->silhouette_rel_sigma) || !isfinite(p->silhouette_sigma_u_px) || !isfinite(p->silhouette_sigma_v_px) ||
+        !isfinite(p->subpixel_rel_sigma) ||
         !isfinite(p->group_silhouette_sigma_u_px) || !isfinite(p->group_silhouette_sigma_v_px))
         return CYL_ERR_ARG;
     return CYL_OK;

@@ -418,6 +418,24 @@ static void test_end_to_end(void **st)
         assert_true(f.subpixel == 1 && f.silhouette_sigma_u_px == 0.05 && f.silhouette_sigma_v_px == 0.125);
         assert_true(f.group_silhouette_sigma_u_px == 0.25 && f.group_silhouette_sigma_v_px == 0.25);
         assert_true(p.subpixel == 0 && p.silhouette_sigma_u_px == 0.25 && p.silhouette_sigma_v_px == 0.25);
+        /* the shift is a correction with subpixel_rel_sigma of itself as its uncertainty: with the
+         * silhouette corrected, the bias variance (and the centroid's) grows by (R du)^2, (R dv)^2 */
+        {
+            cyl_observation o0[1], o1[1];
+            assert_true(f.subpixel_rel_sigma == 0.0 && p.subpixel_rel_sigma == 0.0);   /* off by default */
+            q.silhouette_rel_sigma = 0.25;
+            q.subpixel_rel_sigma = 0.0;
+            assert_int_equal(cyl_observe(&seg, &cam, &q, NULL, 0, o0, 1, &ns), CYL_OK);
+            q.subpixel_rel_sigma = 0.25;
+            assert_int_equal(cyl_observe(&seg, &cam, &q, NULL, 0, o1, 1, &ns), CYL_OK);
+            assert_true(fabs(o1[0].subpixel_du_px) > 0.003);
+            assert_true(fabs(o1[0].bias_var_u_px2 - o0[0].bias_var_u_px2 - pow(0.25 * o1[0].subpixel_du_px, 2)) < 1e-12);
+            assert_true(fabs(o1[0].bias_var_v_px2 - o0[0].bias_var_v_px2 - pow(0.25 * o1[0].subpixel_dv_px, 2)) < 1e-12);
+            assert_true(fabs(o1[0].var_u_px2 - o0[0].var_u_px2 - pow(0.25 * o1[0].subpixel_du_px, 2)) < 1e-12);
+            assert_true(o1[0].u_px == o0[0].u_px && o1[0].v_px == o0[0].v_px);   /* the point does not move */
+            q.subpixel_rel_sigma = NAN;
+            assert_int_equal(cyl_observe(&seg, &cam, &q, NULL, 0, o1, 1, &ns), CYL_ERR_ARG);
+        }
     }
     /* The calibration's share: cov_rb_frame = the covariance with every calibration sigma zeroed
      * (fx fy cx cy and the mount), and jac_calib against central differences. */

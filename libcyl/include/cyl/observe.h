@@ -131,6 +131,15 @@ typedef struct cyl_observe_params {
                                                    0: the blob's centroid, as the table cut it; 1
                                                    with the frame) */
     cyl_subpixel_params subpixel_params;        /* default cyl_subpixel_params_default() */
+    double subpixel_rel_sigma;                  /* the sub-pixel edges' shift of a single blob's
+                                                   centroid (subpixel_du_px, dv_px) is a
+                                                   correction too: this share of it is its
+                                                   uncertainty, added to the bias variance
+                                                   (bias_var_*) where the silhouette is corrected
+                                                   (default 0: none; 0.25, silhouette_rel_sigma's
+                                                   prior, trades cautious poses at the nominal
+                                                   noise for consistent ones at half the noise and
+                                                   in the hard scene: docs/uncertainty.md) */
 } cyl_observe_params;
 
 typedef struct cyl_observation {
