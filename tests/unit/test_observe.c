@@ -70,9 +70,10 @@ static void hs_rect(hseg *h, uint8_t cls, int x0, int y0, int x1, int y1)
     h->seg.n_blobs++;
 }
 
-/* render a landmark of diameter D, height Hm at robot-frame (x, y) as a rectangle */
-static void render(hseg *h, const cyl_camera *cam, uint8_t cls, double x, double y, double D,
-                   double Hm)
+/* the box, px (inclusive), of a landmark of diameter D, height Hm at robot-frame (x, y): pixel k
+ * covers [k - 0.5, k + 0.5], so the pixels inside [u - w/2, u + w/2] */
+static void landmark_box(const cyl_camera *cam, double x, double y, double D, double Hm, int *x0, int *y0,
+                         int *x1, int *y1)
 {
     double u, v, w, hh;
     cyl_rb_result r;
@@ -80,9 +81,19 @@ static void render(hseg *h, const cyl_camera *cam, uint8_t cls, double x, double
     assert_int_equal(cyl_range_bearing(cam, CYL_GEOM_EXACT, u, v, 0, 0, 0, &r), CYL_OK);
     w = cam->fx_px * D / r.depth_m;
     hh = cam->fy_px * Hm / r.depth_m;
-    /* pixel k covers [k - 0.5, k + 0.5]: the pixels inside [u - w/2, u + w/2] */
-    hs_rect(h, cls, (int)lround(u - w / 2 + 0.5), (int)lround(v - hh / 2 + 0.5),
-            (int)lround(u + w / 2 - 0.5), (int)lround(v + hh / 2 - 0.5));
+    *x0 = (int)lround(u - w / 2 + 0.5);
+    *y0 = (int)lround(v - hh / 2 + 0.5);
+    *x1 = (int)lround(u + w / 2 - 0.5);
+    *y1 = (int)lround(v + hh / 2 - 0.5);
+}
+
+/* render a landmark of diameter D, height Hm at robot-frame (x, y) as a rectangle */
+static void render(hseg *h, const cyl_camera *cam, uint8_t cls, double x, double y, double D,
+                   double Hm)
+{
+    int x0, y0, x1, y1;
+    landmark_box(cam, x, y, D, Hm, &x0, &y0, &x1, &y1);
+    hs_rect(h, cls, x0, y0, x1, y1);
 }
 
 static void test_rendered_landmarks(void **st)
@@ -186,21 +197,6 @@ static void test_flags(void **st)
 }
 
 /* End to end: a rectangle drawn in a synthetic frame, segmented by cyl_segment, observed. */
-/* the box, px (inclusive), of a landmark 0.16 m wide and 0.30 m tall at robot-frame (1.5, 0.2) m */
-static void landmark_box(const cyl_camera *cam, int *x0, int *y0, int *x1, int *y1)
-{
-    double u, v, w, hh;
-    cyl_rb_result r;
-    assert_int_equal(cyl_rb_project(cam, 1.5, 0.2, &u, &v), CYL_OK);
-    assert_int_equal(cyl_range_bearing(cam, CYL_GEOM_EXACT, u, v, 0, 0, 0, &r), CYL_OK);
-    w = cam->fx_px * 0.16 / r.depth_m;
-    hh = cam->fy_px * 0.30 / r.depth_m;
-    *x0 = (int)lround(u - w / 2 + 0.5);
-    *y0 = (int)lround(v - hh / 2 + 0.5);
-    *x1 = (int)lround(u + w / 2 - 0.5);
-    *y1 = (int)lround(v + hh / 2 - 0.5);
-}
-
 /* aspect_rel and CYL_OBS_PARTIAL: a whole landmark's box has the expected width-to-height ratio
  * (aspect_rel = (w/h) / (w_est/h_est), near 1 up to the rounding of its corners); the same landmark
  * with a side hidden (60% of its width seen) or its top hidden (60% of its height seen) is flagged,
@@ -218,7 +214,7 @@ static void test_partial(void **st)
     p.silhouette_rel_sigma = -1;
     p.size[0].diameter_m = 0.16;
     p.size[0].height_m = 0.30;
-    landmark_box(&cam, &x0, &y0, &x1, &y1);
+    landmark_box(&cam, 1.5, 0.2, 0.16, 0.30, &x0, &y0, &x1, &y1);
     hs_init(&H);
     hs_rect(&H, 0, x0, y0, x1, y1);                                   /* whole */
     hs_rect(&H, 0, x0 + 200, y0, x0 + 200 + (int)lround(0.6 * (x1 - x0 + 1)) - 1, y1);  /* a side hidden */
@@ -277,7 +273,7 @@ static void test_partial_area(void **st)
     p.partial_offset_max = 0.0;   /* the area alone first */
     p.size[0].diameter_m = 0.16;
     p.size[0].height_m = 0.30;
-    landmark_box(&cam, &x0, &y0, &x1, &y1);
+    landmark_box(&cam, 1.5, 0.2, 0.16, 0.30, &x0, &y0, &x1, &y1);
     third = (y1 - y0 + 1) / 3;
     hs_init(&H);
     hs_rect(&H, 0, x0, y0, x1, y1);

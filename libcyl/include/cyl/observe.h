@@ -187,7 +187,7 @@ typedef struct cyl_observation {
     double offset_rel;          /* (u_px - the blob box's middle column) / w_px, unitless: a whole
                                    landmark's silhouette is symmetric about its axis, so its
                                    measurement point lies at the box's middle (within 0.04 of the
-                                   width on 99% of the synthetic drives' views); a side missing
+                                   width on 99% of the synthetic drives' views used whole); a side missing
                                    moves the centroid by about half the missing share of the width
                                    while the box stays; 0 when unknown (as area_rel) */
     /* The calibration's share, for back ends that estimate the calibration error as a state:
