@@ -94,6 +94,10 @@ const char *kUsage =
     "  --subpixel-rel-sigma R   uncertainty of the sub-pixel edges' shift of a blob's centroid,\n"
     "                       as a share of the shift, added to its bias variance (default 0:\n"
     "                       none; docs/uncertainty.md, \"Other scenes\")\n"
+    "  --missing-part-share S   a part missing from a blob's box (aspect_rel away from 1) moves\n"
+    "                       its centroid by up to half of it: S of that shift is added as a\n"
+    "                       bias sigma (default 0: none; 0.5 for scenes whose blobs lose\n"
+    "                       parts: docs/uncertainty.md)\n"
     "  --overlay DIR|FILE.avi   write overlay images (PNG per frame) or a video\n"
     "  --show               show the overlay in a window (needs a display; q or Esc stops)\n"
     "clutter rejection (per class with CLASS=VALUE, every class with VALUE; the command line\n"
@@ -129,6 +133,7 @@ struct Args {
     double partial_area_min = -1.0;     // < 0: libcyl's default
     double partial_offset_max = -1.0;   // < 0: libcyl's default
     double subpixel_rel_sigma = -1.0;   // < 0: libcyl's default
+    double missing_part_share = -1.0;   // < 0: libcyl's default
     std::string silhouette_sigma;
     uint64_t max_frames = 0;
     bool show = false, quiet = false, fixed_exposure = false, lenient = false;
@@ -195,6 +200,11 @@ Args parse(int argc, char **argv)
             a.partial_offset_max = parse_double(s, val(s));
             if (!(a.partial_offset_max >= 0 && a.partial_offset_max <= 1))
                 usage_error("--partial-offset-max: must be 0..1 (0: off)");
+        }
+        else if (s == "--missing-part-share") {
+            a.missing_part_share = parse_double(s, val(s));
+            if (!(a.missing_part_share >= 0 && a.missing_part_share <= 10))
+                usage_error("--missing-part-share: must be 0..10 (0: none)");
         }
         else if (s == "--subpixel-rel-sigma") {
             a.subpixel_rel_sigma = parse_double(s, val(s));
@@ -398,6 +408,7 @@ int cmd_detect(const Args &a)
     if (a.partial_area_min >= 0) cfg.observe.partial_area_min = a.partial_area_min;
     if (a.partial_offset_max >= 0) cfg.observe.partial_offset_max = a.partial_offset_max;
     if (a.subpixel_rel_sigma >= 0) cfg.observe.subpixel_rel_sigma = a.subpixel_rel_sigma;
+    if (a.missing_part_share >= 0) cfg.observe.missing_part_share = a.missing_part_share;
     cyl_camera cam;
     if (!a.calib.empty()) {
         CameraCalibration cal = load_mounted_camera_calibration(a.calib, a.lenient);

@@ -30,6 +30,7 @@ cyl_observe_params cyl_observe_params_default(void)
     p.subpixel = 0;
     p.subpixel_params = cyl_subpixel_params_default();
     p.subpixel_rel_sigma = 0.0;
+    p.missing_part_share = CYL_MISSING_PART_SHARE_DEFAULT;
     return p;
 }
 
@@ -161,6 +162,31 @@ static void calib_share(cyl_observation *o, const cyl_camera *cam, const cyl_rb_
         }
 }
 
+/* A part missing from the blob's box, or extra, as aspect_rel measures it against the whole
+ * landmark's (a side: aspect_rel < 1; the top or bottom: > 1), moves the centroid by half its size
+ * if it lies on one side, and which side is not known: `share` of that shift is the sigma of a
+ * bias added to the point's (var_*, bias_var_*) and to the covariances it enters, to first order
+ * (rb's Jacobians at the point). */
+static void add_missing_part(cyl_observation *o, const cyl_rb_result *rb, double share)
+{
+    const double su = share * o->w_px * fmax(1.0 / o->aspect_rel - 1.0, 0.0) / 2.0;
+    const double sv = share * o->h_px * fmax(1.0 - 1.0 / o->aspect_rel, 0.0) / 2.0;
+    const double vu = su * su, vv = sv * sv;
+    int a, c;
+    for (a = 0; a < 2; a++)
+        for (c = 0; c < 2; c++) {
+            const double d = rb->jac[a][CYL_IN_U] * vu * rb->jac[c][CYL_IN_U] + rb->jac[a][CYL_IN_V] * vv * rb->jac[c][CYL_IN_V];
+            o->cov_rb[a][c] += d;
+            o->cov_rb_frame[a][c] += d;
+            o->cov_xy[a][c] += rb->jac_xy[a][CYL_IN_U] * vu * rb->jac_xy[c][CYL_IN_U] +
+                               rb->jac_xy[a][CYL_IN_V] * vv * rb->jac_xy[c][CYL_IN_V];
+        }
+    o->var_u_px2 += vu;
+    o->var_v_px2 += vv;
+    o->bias_var_u_px2 += vu;
+    o->bias_var_v_px2 += vv;
+}
+
 /* From the measurement point's centroid and variances (o->centroid_*, o->var_*) and box (w_px,
  * h_px): the silhouette correction, range and bearing with their covariances, the calibration's
  * share, the non-linearity flag, the confidence against the expected box of conf_size, and (a
@@ -216,6 +242,9 @@ static void locate(cyl_observation *o, const cyl_camera *cam, const cyl_observe_
                     ((p->partial_area_min > 0.0 && o->area_rel < p->partial_area_min) ||
                      (p->partial_offset_max > 0.0 && fabs(o->offset_rel) > p->partial_offset_max)))
                     o->flags |= CYL_OBS_PARTIAL;
+                /* after the flags: the range's linearity is judged on the centroid's own spread */
+                if (p->missing_part_share > 0.0 && o->aspect_rel > 0.0)
+                    add_missing_part(o, &rb, p->missing_part_share);
             }
         } else {
             o->flags |= CYL_OBS_NO_SIZE;
@@ -329,6 +358,7 @@ static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *c
     /* a sigma of the silhouette's offset may be negative (no correction) but not infinite or NaN */
     if (!isfinite(p->silhouette_rel_sigma) || !isfinite(p->silhouette_sigma_u_px) || !isfinite(p->silhouette_sigma_v_px) ||
         !isfinite(p->subpixel_rel_sigma) ||
+        !isfinite(p->missing_part_share) || p->missing_part_share < 0.0 ||
         !isfinite(p->group_silhouette_sigma_u_px) || !isfinite(p->group_silhouette_sigma_v_px))
         return CYL_ERR_ARG;
     return CYL_OK;

@@ -431,6 +431,44 @@ static void test_end_to_end(void **st)
             assert_true(o1[0].u_px == o0[0].u_px && o1[0].v_px == o0[0].v_px);   /* the point does not move */
             q.subpixel_rel_sigma = NAN;
             assert_int_equal(cyl_observe(&seg, &cam, &q, NULL, 0, o1, 1, &ns), CYL_ERR_ARG);
+            q.subpixel_rel_sigma = 0.0;
+        }
+        /* a part missing from the box: with missing_part_share S, the bias sigma is S times half
+         * the missing width w (1/a - 1) (a = aspect_rel < 1) or height h (1 - 1/a) (a > 1), added
+         * to the point's variances, the bias's and, through the point's Jacobian (jac_calib's cx,
+         * cy columns: u - cx enters, so d/dcx = -d/du), to the range-bearing covariance */
+        {
+            cyl_observation o0[1], o1[1];
+            double a, su, sv, vu, vv;
+            int r, c;
+            assert_true(f.missing_part_share == 0.0 && p.missing_part_share == 0.0);   /* off by default */
+            q.silhouette_rel_sigma = 0.25;
+            q.missing_part_share = 0.0;
+            assert_int_equal(cyl_observe(&seg, &cam, &q, NULL, 0, o0, 1, &ns), CYL_OK);
+            q.missing_part_share = 0.5;
+            assert_int_equal(cyl_observe(&seg, &cam, &q, NULL, 0, o1, 1, &ns), CYL_OK);
+            a = o0[0].aspect_rel;
+            assert_true(a > 0.0 && fabs(a - 1.0) > 1e-3 && o1[0].aspect_rel == a && o0[0].area_rel > 0.0);
+            su = a < 1.0 ? 0.5 * o0[0].w_px * (1.0 / a - 1.0) / 2.0 : 0.0;
+            sv = a > 1.0 ? 0.5 * o0[0].h_px * (1.0 - 1.0 / a) / 2.0 : 0.0;
+            vu = su * su;
+            vv = sv * sv;
+            assert_true(vu + vv > 1e-4);
+            assert_true(fabs(o1[0].var_u_px2 - o0[0].var_u_px2 - vu) < 1e-12 && fabs(o1[0].var_v_px2 - o0[0].var_v_px2 - vv) < 1e-12);
+            assert_true(fabs(o1[0].bias_var_u_px2 - o0[0].bias_var_u_px2 - vu) < 1e-12);
+            assert_true(fabs(o1[0].bias_var_v_px2 - o0[0].bias_var_v_px2 - vv) < 1e-12);
+            for (r = 0; r < 2; r++)
+                for (c = 0; c < 2; c++) {
+                    const double d = o0[0].jac_calib[r][2] * vu * o0[0].jac_calib[c][2] + o0[0].jac_calib[r][3] * vv * o0[0].jac_calib[c][3];
+                    assert_true(fabs(o1[0].cov_rb[r][c] - o0[0].cov_rb[r][c] - d) < 1e-9 * fabs(o0[0].cov_rb[r][r]) + 1e-15);
+                    assert_true(fabs(o1[0].cov_rb_frame[r][c] - o0[0].cov_rb_frame[r][c] - d) < 1e-9 * fabs(o0[0].cov_rb[r][r]) + 1e-15);
+                }
+            assert_true(o1[0].u_px == o0[0].u_px && o1[0].v_px == o0[0].v_px && o1[0].range_m == o0[0].range_m);
+            assert_true(o1[0].flags == o0[0].flags);
+            q.missing_part_share = -0.1;
+            assert_int_equal(cyl_observe(&seg, &cam, &q, NULL, 0, o1, 1, &ns), CYL_ERR_ARG);
+            q.missing_part_share = NAN;
+            assert_int_equal(cyl_observe(&seg, &cam, &q, NULL, 0, o1, 1, &ns), CYL_ERR_ARG);
         }
     }
     /* The calibration's share: cov_rb_frame = the covariance with every calibration sigma zeroed

@@ -69,6 +69,14 @@ extern "C" {
  * is below 0.0403 on 99% of them (docs/uncertainty.md, "Blobs with a side missing"). */
 #define CYL_PARTIAL_OFFSET_MAX_DEFAULT 0.04
 
+/* Default of cyl_observe_params.missing_part_share: 0 (off). 0.5 is what the tuning drives of two
+ * rendered scenes choose (the most drives with both joint ANEES inside, 35 of 52 against 29; held
+ * out 72 of 92 against 69, the hard scene's landmarks inside on 8 of 10 against 3), but on clean
+ * views it doubles the variance (pixel-noise-only NEES 2.07 -> 0.94, seed 101): aspect_rel spreads
+ * from the box's rounding where nothing is missing (docs/uncertainty.md, "A part missing from the
+ * box"). */
+#define CYL_MISSING_PART_SHARE_DEFAULT 0.0
+
 /* Default of cyl_observe_params.partial_area_min: 0 (off). On the same drives area_rel is above
  * 0.775 on 99% of the views at the nominal sensor noise, but at twice the noise a whole landmark's
  * blob breaks into pieces and keeps 0.75 of its area (median): no threshold separates that from a
@@ -140,6 +148,15 @@ typedef struct cyl_observe_params {
                                                    prior, trades cautious poses at the nominal
                                                    noise for consistent ones at half the noise and
                                                    in the hard scene: docs/uncertainty.md) */
+    double missing_part_share;                  /* a part missing from a single blob's box, or
+                                                   extra, as aspect_rel measures it (w_px (1/aspect_rel
+                                                   - 1) of its width, h_px (1 - 1/aspect_rel) of its
+                                                   height), moves the centroid by up to half of it,
+                                                   to a side not known: this share of that shift is
+                                                   taken as a bias sigma, px, added to var_*_px2,
+                                                   bias_var_*_px2 and the covariances, where the
+                                                   silhouette is corrected (default
+                                                   CYL_MISSING_PART_SHARE_DEFAULT; 0: none) */
 } cyl_observe_params;
 
 typedef struct cyl_observation {
