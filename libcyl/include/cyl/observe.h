@@ -73,8 +73,7 @@ extern "C" {
  * rendered scenes choose (the most drives with both joint ANEES inside, 35 of 52 against 29; held
  * out 72 of 92 against 69, the hard scene's landmarks inside on 8 of 10 against 3), but on clean
  * views it doubles the variance (pixel-noise-only NEES 2.07 -> 0.94, seed 101): aspect_rel spreads
- * from the box's rounding where nothing is missing (docs/uncertainty.md, "A part missing from the
- * box"). */
+ * over 0.805-1.075 where nothing is missing (docs/uncertainty.md, "A part missing from the box"). */
 #define CYL_MISSING_PART_SHARE_DEFAULT 0.0
 
 /* Default of cyl_observe_params.partial_area_min: 0 (off). On the same drives area_rel is above
