@@ -34,6 +34,7 @@ import json
 import math
 import os
 import re
+import shlex
 import statistics
 import subprocess
 import sys
@@ -124,25 +125,25 @@ def scene_detector(build, out, scene, written):
     return det
 
 
-def render_and_detect(build, d, seed, frames, scene=None, detector=None):
+def render_and_detect(build, d, seed, frames, scene=None, detector=None, extra=()):
     """cyl-render a drive (a calibration error drawn once; the built-in scene, or a scene file)
     into directory d and cyl detect it (the built-in scene's table, camera and landmark size, or
-    `detector`'s arguments from scene_detector()): (the observation log's path, the renderer's
-    stderr, which names the true camera)."""
+    `detector`'s arguments from scene_detector(); then `extra`, more cyl detect options): (the
+    observation log's path, the renderer's stderr, which names the true camera)."""
     os.makedirs(d, exist_ok=True)
     raw, obs = os.path.join(d, "drive.cylraw"), os.path.join(d, "observations.jsonl")
     rendered = run_process([os.path.join(build, "cyl-render"), "-o", raw, "-n", str(frames), "-s", str(seed),
                             "--calib-error", "-q"] + (["-S", scene] if scene else []))
     det = detector or ["--table", "calib_data/synthetic.cylt", "--calib", "calib_data/synthetic_camera.yaml",
                        "--size", "orange=0.10,0.30", "--size", "green=0.10,0.30"]
-    run([os.path.join(build, "cyl"), "detect", raw] + det + ["--out", obs, "--quiet"])
+    run([os.path.join(build, "cyl"), "detect", raw] + det + list(extra) + ["--out", obs, "--quiet"])
     os.remove(raw)
     return obs, rendered.stderr
 
 
-def drive(build, out, seed, frames, python, scene=None, detector=None):
+def drive(build, out, seed, frames, python, scene=None, detector=None, extra=()):
     d = os.path.join(out, f"seed{seed}")
-    obs, _ = render_and_detect(build, d, seed, frames, scene, detector)
+    obs, _ = render_and_detect(build, d, seed, frames, scene, detector, extra)
     env = dict(os.environ, PYTHONPATH="slam_demo")
     run([python, "-m", "cylslam", "run", obs, "--out", os.path.join(d, "slam"), "--calib-states", "--no-plot",
          "--no-progress"], env=env)
@@ -200,7 +201,14 @@ def main():
                     help="render the drives in this scene (a cyl-render built-in name or scene file) instead of "
                          "the built-in default, with the scene's camera, a colour table trained on its rendered "
                          "colours (cyl-render --write-table) and its landmark size")
+    ap.add_argument("--detect-args", default="",
+                    help="more cyl detect options for every drive, as one string (e.g. '--missing-part-share "
+                         "0.5'); cyl detect judges them")
     a = ap.parse_args()
+    try:
+        extra = shlex.split(a.detect_args)
+    except ValueError as e:
+        ap.error(f"--detect-args: {e}")
     if not a.noise_scale > 0:
         ap.error(f"--noise-scale {a.noise_scale}: must be > 0")
     seeds = a.seeds or ([101, 102] if a.quick else list(range(101, 121)))
@@ -222,7 +230,7 @@ def main():
     print(f"{'seed':>5} {'lm ANEES':>9} {'(marg.)':>8} {'bounds':>11} {'pose ANEES':>10} {'(marg.)':>8} {'bounds':>11} "
           f"{'ATE m':>8} {'fixed m':>8} {'dead-r m':>8} {'assoc':>5} {'mapped':>7}")
     for i, seed in enumerate(seeds):
-        s = drive(a.build, out, seed, frames, a.python, scene, detector)
+        s = drive(a.build, out, seed, frames, a.python, scene, detector, extra)
         r = {"seed": seed, "anees_landmarks": s.get("anees_landmarks_joint"),
              "anees_landmarks_bounds95": s.get("anees_landmarks_joint_bounds95"),
              "anees_poses": s.get("anees_poses_joint"), "anees_poses_bounds95": s.get("anees_poses_joint_bounds95"),
@@ -273,6 +281,7 @@ def main():
 
     res = {
         "seeds": seeds, "frames": frames, "noise_scale": a.noise_scale, "scene": a.scene or "default (built-in table)",
+        "detect_args": extra,
         "seeds_landmark_anees_in_bounds": round(lm_in / n, 3),
         "seeds_pose_anees_in_bounds": round(pose_in / n, 3),
         "seeds_landmark_anees_marginal_in_bounds": round(lm_in_m / n, 3),

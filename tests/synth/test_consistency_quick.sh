@@ -9,7 +9,8 @@
 # figures (20 seeds) are make consistency's. Then one short drive in another scene (--scene with
 # tests/fixtures/scenes/variant.yaml): the camera, table and landmark size come from that scene
 # (its 8 deg tilt and 0.25 m camera height above the landmarks' middle in the camera file the
-# detector used) and the SLAM run gives both ANEES. GoogleTest-style lines.
+# detector used) and the SLAM run gives both ANEES. Then --detect-args reaching cyl detect: a
+# value cyl detect refuses ends the run with its message. GoogleTest-style lines.
 #   test_consistency_quick.sh BUILD_DIR
 set -u
 B=$1
@@ -67,5 +68,13 @@ if not (isinstance(r["anees_poses"][0], float) and isinstance(r["anees_landmarks
 print("; ".join(bad))
 PY
 )
-if [ -z "$msg" ]; then echo "[       OK ] consistency.scene_file ($(tail -1 "$T/slog" | cut -c1-160))"; echo "[  PASSED  ] 2 tests."
+if [ -z "$msg" ]; then echo "[       OK ] consistency.scene_file ($(tail -1 "$T/slog" | cut -c1-160))"
 else echo "  $msg"; echo "[  FAILED  ] consistency.scene_file"; exit 1; fi
+
+echo "[ RUN      ] consistency.detect_args"
+if .venv/bin/python scripts/consistency.py --scene tests/fixtures/scenes/variant.yaml --seeds 101 --frames 2 \
+     --drives-only --build "$B" --out "$T/d" --detect-args "--missing-part-share -1" >"$T/dlog" 2>"$T/derr"; then
+  echo "  --detect-args '--missing-part-share -1' did not fail"; echo "[  FAILED  ] consistency.detect_args"; exit 1
+fi
+if grep -q -- "--missing-part-share: must be 0..10" "$T/derr"; then echo "[       OK ] consistency.detect_args"; echo "[  PASSED  ] 3 tests."
+else echo "  no cyl detect message in: $(tail -3 "$T/derr")"; echo "[  FAILED  ] consistency.detect_args"; exit 1; fi
