@@ -163,6 +163,18 @@ double parse_double(const std::string &opt, const std::string &v)
     return x;
 }
 
+// a number in [lo, hi], else the usage error "OPT: must be LO..HI (0: ZERO)"
+double parse_in_range(const std::string &opt, const std::string &v, double lo, double hi, const char *zero)
+{
+    const double x = parse_double(opt, v);
+    if (!(x >= lo && x <= hi)) {
+        char msg[64];
+        std::snprintf(msg, sizeof msg, ": must be %g..%g (0: %s)", lo, hi, zero);
+        usage_error(opt + msg);
+    }
+    return x;
+}
+
 Args parse(int argc, char **argv)
 {
     Args a;
@@ -196,31 +208,11 @@ Args parse(int argc, char **argv)
             a.var_floor_px2 = parse_double(s, val(s));
             if (a.var_floor_px2 < 0) usage_error("--centroid-var-floor: must be >= 0 px^2");
         }
-        else if (s == "--partial-offset-max") {
-            a.partial_offset_max = parse_double(s, val(s));
-            if (!(a.partial_offset_max >= 0 && a.partial_offset_max <= 1))
-                usage_error("--partial-offset-max: must be 0..1 (0: off)");
-        }
-        else if (s == "--missing-part-share") {
-            a.missing_part_share = parse_double(s, val(s));
-            if (!(a.missing_part_share >= 0 && a.missing_part_share <= 10))
-                usage_error("--missing-part-share: must be 0..10 (0: none)");
-        }
-        else if (s == "--subpixel-rel-sigma") {
-            a.subpixel_rel_sigma = parse_double(s, val(s));
-            if (!(a.subpixel_rel_sigma >= 0 && a.subpixel_rel_sigma <= 10))
-                usage_error("--subpixel-rel-sigma: must be 0..10 (0: none)");
-        }
-        else if (s == "--partial-area-min") {
-            a.partial_area_min = parse_double(s, val(s));
-            if (!(a.partial_area_min >= 0 && a.partial_area_min <= 1))
-                usage_error("--partial-area-min: must be 0..1 (0: off)");
-        }
-        else if (s == "--partial-aspect-min") {
-            a.partial_aspect_min = parse_double(s, val(s));
-            if (!(a.partial_aspect_min >= 0 && a.partial_aspect_min <= 2))
-                usage_error("--partial-aspect-min: must be 0..2 (0: off)");
-        }
+        else if (s == "--partial-offset-max") a.partial_offset_max = parse_in_range(s, val(s), 0, 1, "off");
+        else if (s == "--missing-part-share") a.missing_part_share = parse_in_range(s, val(s), 0, 10, "none");
+        else if (s == "--subpixel-rel-sigma") a.subpixel_rel_sigma = parse_in_range(s, val(s), 0, 10, "none");
+        else if (s == "--partial-area-min") a.partial_area_min = parse_in_range(s, val(s), 0, 1, "off");
+        else if (s == "--partial-aspect-min") a.partial_aspect_min = parse_in_range(s, val(s), 0, 2, "off");
         else if (s == "--overlay") {
             a.overlay = val(s);
             const std::string &o = a.overlay;

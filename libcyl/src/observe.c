@@ -165,26 +165,21 @@ static void calib_share(cyl_observation *o, const cyl_camera *cam, const cyl_rb_
 /* A part missing from the blob's box, or extra, as aspect_rel measures it against the whole
  * landmark's (a side: aspect_rel < 1; the top or bottom: > 1), moves the centroid by half its size
  * if it lies on one side, and which side is not known: `share` of that shift is the sigma of a
- * bias added to the point's (var_*, bias_var_*) and to the covariances it enters, to first order
- * (rb's Jacobians at the point). */
-static void add_missing_part(cyl_observation *o, const cyl_rb_result *rb, double share)
+ * bias added to the point's variances (var_*, bias_var_*); the covariances are propagated again
+ * from them at the same point (cyl_rb_compute, calib_share). */
+static void add_missing_part(cyl_observation *o, const cyl_camera *cam, const cyl_observe_params *p, double share)
 {
     const double su = share * o->w_px * fmax(1.0 / o->aspect_rel - 1.0, 0.0) / 2.0;
     const double sv = share * o->h_px * fmax(1.0 - 1.0 / o->aspect_rel, 0.0) / 2.0;
-    const double vu = su * su, vv = sv * sv;
-    int a, c;
-    for (a = 0; a < 2; a++)
-        for (c = 0; c < 2; c++) {
-            const double d = rb->jac[a][CYL_IN_U] * vu * rb->jac[c][CYL_IN_U] + rb->jac[a][CYL_IN_V] * vv * rb->jac[c][CYL_IN_V];
-            o->cov_rb[a][c] += d;
-            o->cov_rb_frame[a][c] += d;
-            o->cov_xy[a][c] += rb->jac_xy[a][CYL_IN_U] * vu * rb->jac_xy[c][CYL_IN_U] +
-                               rb->jac_xy[a][CYL_IN_V] * vv * rb->jac_xy[c][CYL_IN_V];
-        }
-    o->var_u_px2 += vu;
-    o->var_v_px2 += vv;
-    o->bias_var_u_px2 += vu;
-    o->bias_var_v_px2 += vv;
+    cyl_rb_result rb;
+    o->var_u_px2 += su * su;
+    o->var_v_px2 += sv * sv;
+    o->bias_var_u_px2 += su * su;
+    o->bias_var_v_px2 += sv * sv;
+    if (cyl_rb_compute(cam, p->model, o->u_px, o->v_px, o->var_u_px2, o->var_v_px2, 0.0, &rb) != CYL_OK) return;
+    memcpy(o->cov_rb, rb.cov_rb, sizeof o->cov_rb);
+    memcpy(o->cov_xy, rb.cov_xy, sizeof o->cov_xy);
+    calib_share(o, cam, &rb);
 }
 
 /* From the measurement point's centroid and variances (o->centroid_*, o->var_*) and box (w_px,
@@ -244,7 +239,7 @@ static void locate(cyl_observation *o, const cyl_camera *cam, const cyl_observe_
                     o->flags |= CYL_OBS_PARTIAL;
                 /* after the flags: the range's linearity is judged on the centroid's own spread */
                 if (p->missing_part_share > 0.0 && o->aspect_rel > 0.0)
-                    add_missing_part(o, &rb, p->missing_part_share);
+                    add_missing_part(o, cam, p, p->missing_part_share);
             }
         } else {
             o->flags |= CYL_OBS_NO_SIZE;
