@@ -358,6 +358,7 @@ void ObservationLog::frame(uint64_t seq, int64_t t_ns, const std::vector<cyl_obs
         l.integer("area_px", o.area).integer("flags", o.flags);
         if (o.aspect_rel > 0.0) l.num("aspect_rel", o.aspect_rel);
         if (o.area_rel > 0.0) l.num("area_rel", o.area_rel).num("offset_rel", o.offset_rel);
+        if (o.side_colour_rel != 0.0) l.num("side_colour_rel", o.side_colour_rel);
         if (boxes && i < boxes->size()) {
             const std::array<uint16_t, 4> &b = (*boxes)[i];
             l.raw("bbox_px", "[" + std::to_string(b[0]) + "," + std::to_string(b[1]) + "," + std::to_string(b[2]) + "," +

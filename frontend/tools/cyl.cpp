@@ -91,6 +91,9 @@ const char *kUsage =
     "                       not classified; default 0.04; 0: off)\n"
     "  --partial-area-min F     ... and when its blob's area is under F times the area of a\n"
     "                       whole landmark's silhouette there (default 0: off)\n"
+    "  --partial-side-max F     ... and when the landmark's colour goes on beyond one side of its\n"
+    "                       box more than beyond the other, by more than F of a 3 px strip\n"
+    "                       (side_colour_rel; default 0: off; docs/uncertainty.md)\n"
     "  --subpixel-rel-sigma R   uncertainty of the sub-pixel edges' shift of a blob's centroid,\n"
     "                       as a share of the shift, added to its bias variance (default 0:\n"
     "                       none; docs/uncertainty.md, \"Other scenes\")\n"
@@ -132,6 +135,7 @@ struct Args {
     double partial_aspect_min = -1.0;   // < 0: libcyl's default
     double partial_area_min = -1.0;     // < 0: libcyl's default
     double partial_offset_max = -1.0;   // < 0: libcyl's default
+    double partial_side_max = -1.0;     // < 0: libcyl's default
     double subpixel_rel_sigma = -1.0;   // < 0: libcyl's default
     double missing_part_share = -1.0;   // < 0: libcyl's default
     std::string silhouette_sigma;
@@ -209,6 +213,7 @@ Args parse(int argc, char **argv)
             if (a.var_floor_px2 < 0) usage_error("--centroid-var-floor: must be >= 0 px^2");
         }
         else if (s == "--partial-offset-max") a.partial_offset_max = parse_in_range(s, val(s), 0, 1, "off");
+        else if (s == "--partial-side-max") a.partial_side_max = parse_in_range(s, val(s), 0, 2, "off");
         else if (s == "--missing-part-share") a.missing_part_share = parse_in_range(s, val(s), 0, 10, "none");
         else if (s == "--subpixel-rel-sigma") a.subpixel_rel_sigma = parse_in_range(s, val(s), 0, 10, "none");
         else if (s == "--partial-area-min") a.partial_area_min = parse_in_range(s, val(s), 0, 1, "off");
@@ -399,6 +404,7 @@ int cmd_detect(const Args &a)
     if (a.partial_aspect_min >= 0) cfg.observe.partial_aspect_min = a.partial_aspect_min;
     if (a.partial_area_min >= 0) cfg.observe.partial_area_min = a.partial_area_min;
     if (a.partial_offset_max >= 0) cfg.observe.partial_offset_max = a.partial_offset_max;
+    if (a.partial_side_max >= 0) cfg.observe.partial_side_max = a.partial_side_max;
     if (a.subpixel_rel_sigma >= 0) cfg.observe.subpixel_rel_sigma = a.subpixel_rel_sigma;
     if (a.missing_part_share >= 0) cfg.observe.missing_part_share = a.missing_part_share;
     cyl_camera cam;

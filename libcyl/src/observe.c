@@ -4,6 +4,7 @@
 #include "cyl/observe.h"
 #include "cyl/silhouette.h"
 #include "unc_internal.h"
+#include "internal.h"
 
 #include <math.h>
 #include <string.h>
@@ -20,6 +21,7 @@ cyl_observe_params cyl_observe_params_default(void)
     p.nonlinear_rel_sigma = 0.055;
     p.partial_aspect_min = CYL_PARTIAL_ASPECT_MIN_DEFAULT;
     p.partial_area_min = CYL_PARTIAL_AREA_MIN_DEFAULT;
+    p.partial_side_max = CYL_PARTIAL_SIDE_MAX_DEFAULT;
     p.partial_offset_max = CYL_PARTIAL_OFFSET_MAX_DEFAULT;
     p.silhouette_rel_sigma = 0.25;
     p.silhouette_sigma_u_px = 0.25;
@@ -182,6 +184,58 @@ static void add_missing_part(cyl_observation *o, const cyl_camera *cam, const cy
     calib_share(o, cam, &rb);
 }
 
+/* The share of one strip's pixels whose chroma (U - 128, V - 128) points within acos(0.9) of the
+ * blob's mean chroma (mu, mv; its length m) and is at least half as long. */
+static double strip_share(const cyl_image *img, uint32_t xa, uint32_t xb, uint32_t ya, uint32_t yb,
+                          double mu, double mv, double m)
+{
+    uint32_t x, y, n = 0, k = 0;
+    for (y = ya; y <= yb; y++)
+        for (x = xa; x <= xb; x++) {
+            uint8_t Y, U, V;
+            double cu, cv, c;
+            cyl_pixel_fetch(img, x, y, &Y, &U, &V);
+            cu = (double)U - 128.0;
+            cv = (double)V - 128.0;
+            c = sqrt(cu * cu + cv * cv);
+            n++;
+            if (c >= 0.5 * m && cu * mu + cv * mv > 0.9 * c * m) k++;
+        }
+    return n ? (double)k / (double)n : 0.0;
+}
+
+/* side_colour_rel of a blob's box (x0..x1, y0..y1 inclusive, px): the landmark's colour beyond
+ * its left side less beyond its right (cyl_observation.side_colour_rel); 0 when a strip would
+ * leave the frame or the blob has no chroma to compare. */
+static double side_colour(const cyl_image *img, const cyl_blob *b)
+{
+    const uint32_t strip = 3u;
+    uint32_t ya, yb, x, y, n = 0, h, sx, sy;
+    double su = 0.0, sv = 0.0, mu, mv, m;
+    if (b->x0 < strip || b->x1 + strip >= img->width || b->y1 >= img->height || b->x1 < b->x0 + 2u) return 0.0;
+    h = b->y1 - b->y0 + 1u;
+    ya = b->y0 + (uint32_t)(0.2 * (double)h);
+    yb = b->y1 - (uint32_t)(0.2 * (double)h);
+    if (yb < ya) return 0.0;
+    /* the blob's mean chroma from at most about 16 x 16 of its pixels (the strips are read whole) */
+    sx = (b->x1 - b->x0 - 1u) / 16u + 1u;
+    sy = (yb - ya + 1u) / 16u + 1u;
+    for (y = ya; y <= yb; y += sy)
+        for (x = b->x0 + 1u; x < b->x1; x += sx) {
+            uint8_t Y, U, V;
+            cyl_pixel_fetch(img, x, y, &Y, &U, &V);
+            su += (double)U - 128.0;
+            sv += (double)V - 128.0;
+            n++;
+        }
+    mu = su / (double)n;
+    mv = sv / (double)n;
+    m = sqrt(mu * mu + mv * mv);
+    if (!(m >= 1.0)) return 0.0;
+    return strip_share(img, b->x0 - strip, b->x0 - 1u, ya, yb, mu, mv, m) -
+           strip_share(img, b->x1 + 1u, b->x1 + strip, ya, yb, mu, mv, m);
+}
+
 /* From the measurement point's centroid and variances (o->centroid_*, o->var_*) and box (w_px,
  * h_px): the silhouette correction, range and bearing with their covariances, the calibration's
  * share, the non-linearity flag, the confidence against the expected box of conf_size, and (a
@@ -328,6 +382,11 @@ cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
             sh.size = &p->size[b->cls];
             locate(o, cam, p, &sh, &p->size[b->cls], b->flags, area_px2, 0.5 * ((double)b->x0 + (double)b->x1));
         }
+        if (p->image) {
+            o->side_colour_rel = side_colour(p->image, b);
+            if (p->partial_side_max > 0.0 && fabs(o->side_colour_rel) > p->partial_side_max)
+                o->flags |= CYL_OBS_PARTIAL;
+        }
     }
     *n_out = n;
     return ret;
@@ -353,7 +412,7 @@ static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *c
     /* a sigma of the silhouette's offset may be negative (no correction) but not infinite or NaN */
     if (!isfinite(p->silhouette_rel_sigma) || !isfinite(p->silhouette_sigma_u_px) || !isfinite(p->silhouette_sigma_v_px) ||
         !isfinite(p->subpixel_rel_sigma) ||
-        !isfinite(p->missing_part_share) || p->missing_part_share < 0.0 ||
+        !isfinite(p->missing_part_share) || p->missing_part_share < 0.0 || !isfinite(p->partial_side_max) ||
         !isfinite(p->group_silhouette_sigma_u_px) || !isfinite(p->group_silhouette_sigma_v_px))
         return CYL_ERR_ARG;
     return CYL_OK;

@@ -266,6 +266,8 @@ def observe(table: Table, frame: np.ndarray, fmt: str, camera: Camera,
         if o.area_rel > 0.0:
             out[-1]["area_rel"] = o.area_rel
             out[-1]["offset_rel"] = o.offset_rel
+        if o.side_colour_rel != 0.0:
+            out[-1]["side_colour_rel"] = o.side_colour_rel
         if o.subpixel_du_px != 0.0 or o.subpixel_dv_px != 0.0:
             out[-1]["subpixel_shift_px"] = [o.subpixel_du_px, o.subpixel_dv_px]
     del keep

@@ -81,7 +81,7 @@ typedef struct cyl_observe_params { cyl_noise_estimator estimator; cyl_geom_mode
 typedef struct cyl_observation { uint32_t blob; uint8_t cls; uint32_t flags; uint32_t area; double u_px; double v_px;
                                  double var_u_px2; double var_v_px2; double range_m; double bearing_rad;
                                  double cov_rb[2][2]; double x_m; double y_m; double cov_xy[2][2];
-                                 double confidence; double aspect_rel; double area_rel; double offset_rel; double jac_calib[2][8]; double cov_rb_frame[2][2];
+                                 double confidence; double aspect_rel; double area_rel; double offset_rel; double side_colour_rel; double jac_calib[2][8]; double cov_rb_frame[2][2];
                                  double bias_var_u_px2; double bias_var_v_px2; double subpixel_du_px;
                                  double subpixel_dv_px; ...; } cyl_observation;
 cyl_observe_params cyl_observe_params_default(void);

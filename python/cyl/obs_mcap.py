@@ -53,6 +53,7 @@ SCHEMAS: Dict[str, dict] = {
         "aspect_rel": _n("blob width/height over the whole landmark's, < 1 a side hidden"),
         "area_rel": _n("blob area over the whole landmark's silhouette's, < 1 parts not classified"),
         "offset_rel": _n("(u_px - box middle column) / box width, away from 0 a side not classified"),
+        "side_colour_rel": _n("share of a strip left of the box in the blob's colour less that right of it, -1..1"),
         "flags": {"type": "integer"}, "bbox_px": {"type": "array", "items": {"type": "integer"},
                                                   "description": "x0 y0 x1 y1, px, inclusive"},
         "jac_calib": {"type": "array", "items": NUM}, "cov_frame": {"type": "array", "items": NUM},

@@ -96,6 +96,24 @@ for path, m in ((sys.argv[1], 0.8), (sys.argv[2], 0.999)):
     assert m == 0.8 or n > 0, "0.999 flagged nothing"
 PY
 expect_exit 2 "--partial-aspect-min: must be 0..2" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB --partial-aspect-min -1 --out "$T/x.jsonl"
+# side_colour_rel is logged (-1..1) and --partial-side-max F flags 0x800 where |side_colour_rel| > F
+# (and nowhere else that the default run did not flag); off by default
+expect_exit 0 "" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB $SIZES --partial-side-max 0.05 --out "$T/sd.jsonl" --quiet
+python3 - "$T/a.jsonl" "$T/sd.jsonl" <<'PY' || fail "side_colour_rel or its flag"
+import json, sys
+def obs(path):
+    return [o for o in map(json.loads, open(path)) if o["type"] == "obs"]
+a, b = obs(sys.argv[1]), obs(sys.argv[2])
+assert len(a) == len(b) and any("side_colour_rel" in o for o in a), "no side_colour_rel logged"
+n = 0
+for x, y in zip(a, b):
+    s = x.get("side_colour_rel", 0.0)
+    assert -1.0 <= s <= 1.0 and s == y.get("side_colour_rel", 0.0), (x["seq"], s)
+    assert bool(y["flags"] & 0x800) == (bool(x["flags"] & 0x800) or abs(s) > 0.05), (x["seq"], s, x["flags"], y["flags"])
+    n += abs(s) > 0.05 and not x["flags"] & 0x800
+assert n > 0, "0.05 flagged nothing more"
+PY
+expect_exit 2 "--partial-side-max: must be 0..2" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB --partial-side-max -0.1 --out "$T/x.jsonl"
 finish
 
 start stdout_stream

@@ -11,6 +11,7 @@
 #include <cmocka.h>
 
 #include "cyl/observe.h"
+#include "cyl/image.h"
 #include "cyl/colortable.h"
 #include "cyl/silhouette.h"
 #include "cylinder_ref.h"
@@ -333,6 +334,104 @@ static void test_partial_area(void **st)
     assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
     assert_true(obs[1].area_rel == 0.0);
     assert_false(obs[1].flags & CYL_OBS_PARTIAL);
+}
+
+/* paint columns xa..xb (whole YUYV pairs: xa even, xb odd) of rows ya..yb */
+static void yuyv_fill(uint8_t *f, int W, int xa, int xb, int ya, int yb, uint8_t Y, uint8_t U, uint8_t V)
+{
+    int x, y;
+    for (y = ya; y <= yb; y++)
+        for (x = xa; x <= xb; x += 2) {
+            uint8_t *q = f + (size_t)y * (size_t)W * 2u + (size_t)x * 2u;
+            q[0] = Y; q[1] = U; q[2] = Y; q[3] = V;
+        }
+}
+
+/* side_colour_rel: the share of a 3 px strip beyond the box's left side in the blob's colour
+ * (its chroma's direction within acos 0.9, at least half its length) less the right strip's;
+ * hand-made frames where each share is 0 or 1, and the flag it drives. */
+static void test_side_colour(void **st)
+{
+    enum { W = 768, Hh = 576 };
+    static uint8_t f[W * Hh * 2];
+    cyl_image img;
+    cyl_camera cam;
+    cyl_observe_params p = cyl_observe_params_default();
+    cyl_observation obs[8];
+    uint32_t n;
+    const int x0 = 300, x1 = 339, y0 = 200, y1 = 299;
+    double u_whole;
+    (void)st;
+    unc_paper_camera(&cam);
+    assert_true(p.partial_side_max == CYL_PARTIAL_SIDE_MAX_DEFAULT);
+    p.size[0].diameter_m = 0.16;
+    p.size[0].height_m = 0.30;
+    hs_init(&H);
+    hs_rect(&H, 0, x0, y0, x1, y1);
+    assert_int_equal(cyl_image_wrap(&img, CYL_FMT_YUYV, W, Hh, f, 0), CYL_OK);
+    yuyv_fill(f, W, 0, W - 1, 0, Hh - 1, 100, 128, 128);              /* grey */
+    yuyv_fill(f, W, x0, x1, y0, y1, 120, 128 - 38, 128 + 52);         /* the blob: orange */
+    /* no frame: not measured */
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_int_equal(n, 1);
+    assert_true(obs[0].side_colour_rel == 0.0);
+    u_whole = obs[0].u_px;
+    p.image = &img;
+    /* grey on both sides */
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(obs[0].side_colour_rel == 0.0);
+    /* a paler orange (0.6 of the chroma) beyond the left side: the left strip is all the blob's
+     * colour, the right none; the measurement point does not move, and the flag follows the option */
+    yuyv_fill(f, W, x0 - 4, x0 - 1, y0, y1, 170, 128 - 23, 128 + 31);
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(fabs(obs[0].side_colour_rel - 1.0) < 1e-12);
+    assert_true(obs[0].u_px == u_whole);
+    assert_false(obs[0].flags & CYL_OBS_PARTIAL);
+    p.partial_side_max = 0.5;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(obs[0].flags & CYL_OBS_PARTIAL);
+    /* weaker than half the blob's chroma (0.4 of it): not the blob's colour */
+    yuyv_fill(f, W, x0 - 4, x0 - 1, y0, y1, 170, 128 - 15, 128 + 21);
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(obs[0].side_colour_rel == 0.0);
+    assert_false(obs[0].flags & CYL_OBS_PARTIAL);
+    /* another hue (green) beyond the left side: not the blob's colour either */
+    yuyv_fill(f, W, x0 - 4, x0 - 1, y0, y1, 120, 128 - 30, 128 - 40);
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(obs[0].side_colour_rel == 0.0);
+    /* the orange beyond the right side only: -1; beyond both: 0 */
+    yuyv_fill(f, W, x0 - 4, x0 - 1, y0, y1, 100, 128, 128);
+    yuyv_fill(f, W, x1 + 1, x1 + 4, y0, y1, 170, 128 - 23, 128 + 31);
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(fabs(obs[0].side_colour_rel + 1.0) < 1e-12);
+    assert_true(obs[0].flags & CYL_OBS_PARTIAL);
+    yuyv_fill(f, W, x0 - 4, x0 - 1, y0, y1, 170, 128 - 23, 128 + 31);
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(obs[0].side_colour_rel == 0.0);
+    /* only the middle 60% of the rows count: orange beyond the left side's top and bottom fifths
+     * alone (rows y0..y0+19 and y1-19..y1 of 100) is not seen; in the middle half of the rows, a
+     * half share */
+    yuyv_fill(f, W, x0 - 4, x1 + 4, 0, Hh - 1, 100, 128, 128);
+    yuyv_fill(f, W, x0, x1, y0, y1, 120, 128 - 38, 128 + 52);
+    yuyv_fill(f, W, x0 - 4, x0 - 1, y0, y0 + 19, 170, 128 - 23, 128 + 31);
+    yuyv_fill(f, W, x0 - 4, x0 - 1, y1 - 19, y1, 170, 128 - 23, 128 + 31);
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(obs[0].side_colour_rel == 0.0);
+    yuyv_fill(f, W, x0 - 4, x0 - 1, y0, y1, 100, 128, 128);
+    yuyv_fill(f, W, x0 - 4, x0 - 1, y0 + 20, y0 + 49, 170, 128 - 23, 128 + 31);   /* rows 20-49 of 20-79 */
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(fabs(obs[0].side_colour_rel - 0.5) < 1e-12);
+    assert_false(obs[0].flags & CYL_OBS_PARTIAL);
+    /* a box whose strip would leave the frame: not measured */
+    hs_init(&H);
+    hs_rect(&H, 0, 2, y0, 41, y1);
+    yuyv_fill(f, W, 0, 1, y0, y1, 170, 128 - 23, 128 + 31);
+    yuyv_fill(f, W, 2, 41, y0, y1, 120, 128 - 38, 128 + 52);
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+    assert_true(obs[0].side_colour_rel == 0.0);
+    /* NaN refused */
+    p.partial_side_max = NAN;
+    assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_ERR_ARG);
 }
 
 static void test_end_to_end(void **st)
@@ -752,6 +851,7 @@ int main(void)
         cmocka_unit_test(test_flags),
         cmocka_unit_test(test_partial),
         cmocka_unit_test(test_partial_area),
+        cmocka_unit_test(test_side_colour),
         cmocka_unit_test(test_end_to_end),
         cmocka_unit_test(test_groups_end_to_end),
     };

@@ -82,6 +82,13 @@ extern "C" {
  * side missing, which offset_rel does. */
 #define CYL_PARTIAL_AREA_MIN_DEFAULT 0.0
 
+/* Default of cyl_observe_params.partial_side_max: 0 (off). side_colour_rel is measured whenever the
+ * frame is at hand. 0.5 is what 24 tuning drives of two rendered scenes choose (both joint ANEES
+ * inside on 15 against 14), but held out it cost the built-in scene's drives 5% of median ATE and
+ * one drive against the fixed-covariance oracle for the hard scene's association errors (7 to 0)
+ * (docs/uncertainty.md, "The landmark's colour beyond one side of the box"). */
+#define CYL_PARTIAL_SIDE_MAX_DEFAULT 0.0
+
 /* Calibration parameters in cyl_observation.jac_calib: fx fy cx cy tilt yaw h s. Their prior
  * covariance is cyl_calib_cov(). */
 #define CYL_CALIB_COUNT 8
@@ -106,6 +113,9 @@ typedef struct cyl_observe_params {
     double partial_area_min;                    /* CYL_OBS_PARTIAL when area_rel is below this
                                                    (default CYL_PARTIAL_AREA_MIN_DEFAULT: off; <= 0
                                                    disables) */
+    double partial_side_max;                    /* CYL_OBS_PARTIAL when |side_colour_rel| is above
+                                                   this (default CYL_PARTIAL_SIDE_MAX_DEFAULT: off;
+                                                   <= 0 disables; needs image) */
     cyl_landmark_size size[CYL_MAX_CLASSES];    /* physical size of each class's landmarks, m
                                                    (default 0 = unknown) */
     /* CYL_NOISE_IMAGE and subpixel: the frame and colour table seg was made from, and the image
@@ -222,6 +232,14 @@ typedef struct cyl_observation {
     double code_confidence;     /* the group's code confidence, 0..1 */
     double z_ref_m;             /* height above the centroid plane of the axis point the range and
                                    bearing refer to (cyl_observe_groups; 0 for a blob's), m */
+    double side_colour_rel;     /* share of the pixels in a 3 px strip just left of the blob's box
+                                   (its middle 60% of rows) whose chroma is the blob's (pointing
+                                   within 25.8 deg of the blob's mean chroma, at least half as
+                                   strong), less that share just right of it, -1..1, unitless: the
+                                   landmark's colour going on beyond one side, a part of it not
+                                   classified there (a lit side paler than the class), which moves
+                                   the centroid away from that side; 0 when not measured (no image,
+                                   a group, the strips outside the frame, a colourless blob) */
 } cyl_observation;
 
 #define CYL_NO_MODEL 0xFFFFu    /* cyl_observation.model of an observation made from one blob */
