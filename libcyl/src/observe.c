@@ -184,6 +184,7 @@ static void add_missing_part(cyl_observation *o, const cyl_camera *cam, const cy
     calib_share(o, cam, &rb);
 }
 
+#if CYL_CONFIG_SUBPIXEL   /* side_colour_rel reads the image around the blob's edges, as sub-pixel edges do */
 /* The share of one strip's pixels whose chroma (U - 128, V - 128) points within acos(0.9) of the
  * blob's mean chroma (mu, mv; its length m) and is at least half as long. */
 static double strip_share(const cyl_image *img, uint32_t xa, uint32_t xb, uint32_t ya, uint32_t yb,
@@ -235,6 +236,7 @@ static double side_colour(const cyl_image *img, const cyl_blob *b)
     return strip_share(img, b->x0 - strip, b->x0 - 1u, ya, yb, mu, mv, m) -
            strip_share(img, b->x1 + 1u, b->x1 + strip, ya, yb, mu, mv, m);
 }
+#endif
 
 /* From the measurement point's centroid and variances (o->centroid_*, o->var_*) and box (w_px,
  * h_px): the silhouette correction, range and bearing with their covariances, the calibration's
@@ -382,11 +384,13 @@ cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
             sh.size = &p->size[b->cls];
             locate(o, cam, p, &sh, &p->size[b->cls], b->flags, area_px2, 0.5 * ((double)b->x0 + (double)b->x1));
         }
+#if CYL_CONFIG_SUBPIXEL
         if (p->image) {
             o->side_colour_rel = side_colour(p->image, b);
             if (p->partial_side_max > 0.0 && fabs(o->side_colour_rel) > p->partial_side_max)
                 o->flags |= CYL_OBS_PARTIAL;
         }
+#endif
     }
     *n_out = n;
     return ret;
@@ -403,7 +407,8 @@ static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *c
     if (work_size < cyl_observe_work_size(seg, p)) return CYL_ERR_NOMEM;
     if (p->model != CYL_GEOM_EXACT && p->model != CYL_GEOM_PAPER) return CYL_ERR_ARG;
     if (!(p->min_var_px2 >= 0.0)) return CYL_ERR_ARG;
-    if ((p->estimator == CYL_NOISE_IMAGE && !CYL_CONFIG_IMAGE_ESTIMATOR) || (p->subpixel && !CYL_CONFIG_SUBPIXEL))
+    if ((p->estimator == CYL_NOISE_IMAGE && !CYL_CONFIG_IMAGE_ESTIMATOR) || (p->subpixel && !CYL_CONFIG_SUBPIXEL) ||
+        (p->partial_side_max > 0.0 && !CYL_CONFIG_SUBPIXEL))
         return CYL_ERR_UNSUPPORTED;   /* compiled out (cyl/config.h) */
     if ((p->estimator == CYL_NOISE_IMAGE || p->subpixel) && (!p->image || !p->table)) return CYL_ERR_ARG;
     if (p->subpixel && (p->subpixel_params.reach < 2u || p->subpixel_params.reach > CYL_SUBPIXEL_MAX_REACH ||

@@ -144,6 +144,14 @@ static void test_features_answer_or_refuse(void **state)
     p.image = &s.img;
     p.table = &s.t;
     assert_int_equal(cyl_observe(&s.seg, &s.cam, &p, NULL, 0, obs, 4, &n), want);
+    /* side_colour_rel and its flag come with the sub-pixel edges (both read the image around the
+     * blob's edges): compiled out, the measure stays 0 and asking for the flag is refused */
+    p = cyl_observe_params_default();
+    p.image = &s.img;
+    assert_int_equal(cyl_observe(&s.seg, &s.cam, &p, NULL, 0, obs, 4, &n), CYL_OK);
+    if (!CYL_CONFIG_SUBPIXEL) assert_true(obs[0].side_colour_rel == 0.0);
+    p.partial_side_max = 0.5;
+    assert_int_equal(cyl_observe(&s.seg, &s.cam, &p, NULL, 0, obs, 4, &n), want);
     /* landmark models */
     {
         cyl_landmark_model m;

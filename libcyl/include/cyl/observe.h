@@ -115,7 +115,8 @@ typedef struct cyl_observe_params {
                                                    disables) */
     double partial_side_max;                    /* CYL_OBS_PARTIAL when |side_colour_rel| is above
                                                    this (default CYL_PARTIAL_SIDE_MAX_DEFAULT: off;
-                                                   <= 0 disables; needs image) */
+                                                   <= 0 disables; needs image; with CYL_CONFIG_SUBPIXEL
+                                                   0, CYL_ERR_UNSUPPORTED) */
     cyl_landmark_size size[CYL_MAX_CLASSES];    /* physical size of each class's landmarks, m
                                                    (default 0 = unknown) */
     /* CYL_NOISE_IMAGE and subpixel: the frame and colour table seg was made from, and the image
@@ -239,7 +240,8 @@ typedef struct cyl_observation {
                                    landmark's colour going on beyond one side, a part of it not
                                    classified there (a lit side paler than the class), which moves
                                    the centroid away from that side; 0 when not measured (no image,
-                                   a group, the strips outside the frame, a colourless blob) */
+                                   a group, the strips outside the frame, a colourless blob, a
+                                   build without CYL_CONFIG_SUBPIXEL) */
 } cyl_observation;
 
 #define CYL_NO_MODEL 0xFFFFu    /* cyl_observation.model of an observation made from one blob */
