@@ -407,8 +407,8 @@ static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *c
     if (work_size < cyl_observe_work_size(seg, p)) return CYL_ERR_NOMEM;
     if (p->model != CYL_GEOM_EXACT && p->model != CYL_GEOM_PAPER) return CYL_ERR_ARG;
     if (!(p->min_var_px2 >= 0.0)) return CYL_ERR_ARG;
-    if ((p->estimator == CYL_NOISE_IMAGE && !CYL_CONFIG_IMAGE_ESTIMATOR) || (p->subpixel && !CYL_CONFIG_SUBPIXEL) ||
-        (p->partial_side_max > 0.0 && !CYL_CONFIG_SUBPIXEL))
+    if ((p->estimator == CYL_NOISE_IMAGE && !CYL_CONFIG_IMAGE_ESTIMATOR) ||
+        ((p->subpixel || p->partial_side_max > 0.0) && !CYL_CONFIG_SUBPIXEL))
         return CYL_ERR_UNSUPPORTED;   /* compiled out (cyl/config.h) */
     if ((p->estimator == CYL_NOISE_IMAGE || p->subpixel) && (!p->image || !p->table)) return CYL_ERR_ARG;
     if (p->subpixel && (p->subpixel_params.reach < 2u || p->subpixel_params.reach > CYL_SUBPIXEL_MAX_REACH ||
