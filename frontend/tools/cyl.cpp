@@ -101,6 +101,10 @@ const char *kUsage =
     "                       its centroid by up to half of it: S of that shift is added as a\n"
     "                       bias sigma (default 0: none; 0.5 for scenes whose blobs lose\n"
     "                       parts: docs/uncertainty.md)\n"
+    "  --side-sigma C           the landmark's colour beyond one side of a blob's box moves its\n"
+    "                       centroid: C x (|side_colour_rel| - D) x the box's width is added as\n"
+    "                       a sigma of its u, px (default 0.25; 0: none; docs/uncertainty.md)\n"
+    "  --side-sigma-free D      |side_colour_rel| up to D adds nothing (default 0.1, 0..1)\n"
     "  --overlay DIR|FILE.avi   write overlay images (PNG per frame) or a video\n"
     "  --show               show the overlay in a window (needs a display; q or Esc stops)\n"
     "clutter rejection (per class with CLASS=VALUE, every class with VALUE; the command line\n"
@@ -138,6 +142,8 @@ struct Args {
     double partial_side_max = -1.0;     // < 0: libcyl's default
     double subpixel_rel_sigma = -1.0;   // < 0: libcyl's default
     double missing_part_share = -1.0;   // < 0: libcyl's default
+    double side_sigma_rel = -1.0;       // < 0: libcyl's default
+    double side_sigma_free = -1.0;      // < 0: libcyl's default
     std::string silhouette_sigma;
     uint64_t max_frames = 0;
     bool show = false, quiet = false, fixed_exposure = false, lenient = false;
@@ -215,6 +221,8 @@ Args parse(int argc, char **argv)
         else if (s == "--partial-offset-max") a.partial_offset_max = parse_in_range(s, val(s), 0, 1, "off");
         else if (s == "--partial-side-max") a.partial_side_max = parse_in_range(s, val(s), 0, 2, "off");
         else if (s == "--missing-part-share") a.missing_part_share = parse_in_range(s, val(s), 0, 10, "none");
+        else if (s == "--side-sigma") a.side_sigma_rel = parse_in_range(s, val(s), 0, 10, "none");
+        else if (s == "--side-sigma-free") a.side_sigma_free = parse_in_range(s, val(s), 0, 1, "every view");
         else if (s == "--subpixel-rel-sigma") a.subpixel_rel_sigma = parse_in_range(s, val(s), 0, 10, "none");
         else if (s == "--partial-area-min") a.partial_area_min = parse_in_range(s, val(s), 0, 1, "off");
         else if (s == "--partial-aspect-min") a.partial_aspect_min = parse_in_range(s, val(s), 0, 2, "off");
@@ -407,6 +415,8 @@ int cmd_detect(const Args &a)
     if (a.partial_side_max >= 0) cfg.observe.partial_side_max = a.partial_side_max;
     if (a.subpixel_rel_sigma >= 0) cfg.observe.subpixel_rel_sigma = a.subpixel_rel_sigma;
     if (a.missing_part_share >= 0) cfg.observe.missing_part_share = a.missing_part_share;
+    if (a.side_sigma_rel >= 0) cfg.observe.side_sigma_rel = a.side_sigma_rel;
+    if (a.side_sigma_free >= 0) cfg.observe.side_sigma_free = a.side_sigma_free;
     cyl_camera cam;
     if (!a.calib.empty()) {
         CameraCalibration cal = load_mounted_camera_calibration(a.calib, a.lenient);

@@ -33,6 +33,8 @@ cyl_observe_params cyl_observe_params_default(void)
     p.subpixel_params = cyl_subpixel_params_default();
     p.subpixel_rel_sigma = 0.0;
     p.missing_part_share = CYL_MISSING_PART_SHARE_DEFAULT;
+    p.side_sigma_rel = CYL_SIDE_SIGMA_REL_DEFAULT;
+    p.side_sigma_free = CYL_SIDE_SIGMA_FREE_DEFAULT;
     return p;
 }
 
@@ -185,6 +187,21 @@ static void add_missing_part(cyl_observation *o, const cyl_camera *cam, const cy
 }
 
 #if CYL_CONFIG_SUBPIXEL   /* side_colour_rel reads the image around the blob's edges, as sub-pixel edges do */
+/* The landmark's colour beyond one side of the box (side_colour_rel) as a sigma of the view's u
+ * bias, added to var_u_px2 alone (it changes from view to view, unlike bias_var); the covariances
+ * are propagated again at the same point. Only observations with a range (locate() succeeded). */
+static void add_side_sigma(cyl_observation *o, const cyl_camera *cam, const cyl_observe_params *p)
+{
+    const double su = p->side_sigma_rel * fmax(fabs(o->side_colour_rel) - p->side_sigma_free, 0.0) * o->w_px;
+    cyl_rb_result rb;
+    if (!(su > 0.0) || (o->flags & (CYL_OBS_INVALID | CYL_OBS_NO_RANGE))) return;
+    o->var_u_px2 += su * su;
+    if (cyl_rb_compute(cam, p->model, o->u_px, o->v_px, o->var_u_px2, o->var_v_px2, 0.0, &rb) != CYL_OK) return;
+    memcpy(o->cov_rb, rb.cov_rb, sizeof o->cov_rb);
+    memcpy(o->cov_xy, rb.cov_xy, sizeof o->cov_xy);
+    calib_share(o, cam, &rb);
+}
+
 /* The share of one strip's pixels whose chroma (U - 128, V - 128) points within acos(0.9) of the
  * blob's mean chroma (mu, mv; its length m) and is at least half as long. */
 static double strip_share(const cyl_image *img, uint32_t xa, uint32_t xb, uint32_t ya, uint32_t yb,
@@ -389,6 +406,7 @@ cyl_status cyl_observe(const cyl_segmentation *seg, const cyl_camera *cam,
             o->side_colour_rel = side_colour(p->image, b);
             if (p->partial_side_max > 0.0 && fabs(o->side_colour_rel) > p->partial_side_max)
                 o->flags |= CYL_OBS_PARTIAL;
+            if (p->side_sigma_rel > 0.0) add_side_sigma(o, cam, p);
         }
 #endif
     }
@@ -418,6 +436,8 @@ static cyl_status observe_check(const cyl_segmentation *seg, const cyl_camera *c
     if (!isfinite(p->silhouette_rel_sigma) || !isfinite(p->silhouette_sigma_u_px) || !isfinite(p->silhouette_sigma_v_px) ||
         !isfinite(p->subpixel_rel_sigma) ||
         !isfinite(p->missing_part_share) || p->missing_part_share < 0.0 || !isfinite(p->partial_side_max) ||
+        !(p->side_sigma_rel >= 0.0) || !isfinite(p->side_sigma_rel) ||
+        !(p->side_sigma_free >= 0.0 && p->side_sigma_free <= 1.0) ||
         !isfinite(p->group_silhouette_sigma_u_px) || !isfinite(p->group_silhouette_sigma_v_px))
         return CYL_ERR_ARG;
     return CYL_OK;

@@ -5,4 +5,4 @@ Modules: data (common in-memory model), obslog (docs/formats.md JSON Lines reade
 mrclam, victoria (readers), synth (synthetic logs), backend (GTSAM graph, iSAM2, association),
 metrics, plot, cli (python -m cylslam).
 """
-__version__ = "0.8.0"  # = CYL_VERSION_STRING of libcyl/include/cyl/version.h (tested)
+__version__ = "0.9.0"  # = CYL_VERSION_STRING of libcyl/include/cyl/version.h (tested)

@@ -114,6 +114,29 @@ for x, y in zip(a, b):
 assert n > 0, "0.05 flagged nothing more"
 PY
 expect_exit 2 "--partial-side-max: must be 0..2" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB --partial-side-max -0.1 --out "$T/x.jsonl"
+# --side-sigma C --side-sigma-free D: (C (|side_colour_rel| - D) w)^2 added to var_u_px2 of every
+# view with a range (w from its bbox_px), nothing else of the centroid changed, the range's variance grown
+expect_exit 0 "" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB $SIZES --side-sigma 0 --out "$T/s0.jsonl" --quiet
+expect_exit 0 "" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB $SIZES --side-sigma 0.5 --side-sigma-free 0.05 --out "$T/s1.jsonl" --quiet
+python3 - "$T/s0.jsonl" "$T/s1.jsonl" <<'PY' || fail "--side-sigma"
+import json, sys
+def obs(path):
+    return [o for o in map(json.loads, open(path)) if o["type"] == "obs"]
+a, b = obs(sys.argv[1]), obs(sys.argv[2])
+assert len(a) == len(b)
+n = 0
+for x, y in zip(a, b):
+    s = abs(x.get("side_colour_rel", 0.0))
+    w = x["bbox_px"][2] - x["bbox_px"][0] + 1
+    add = (0.5 * max(s - 0.05, 0.0) * w) ** 2 if not x["flags"] & 0x300 else 0.0
+    assert abs(y["var_u_px2"] - x["var_u_px2"] - add) <= 1e-6 * (x["var_u_px2"] + add), (x["seq"], s, x["var_u_px2"], y["var_u_px2"], add)
+    assert y["var_v_px2"] == x["var_v_px2"] and y["u_px"] == x["u_px"] and y["flags"] == x["flags"], x["seq"]
+    if add > 0:
+        assert y["cov_rr"] > x["cov_rr"] and y["range_m"] == x["range_m"], x["seq"]
+        n += 1
+assert n > 0, "no view's variance grew"
+PY
+expect_exit 2 "--side-sigma-free: must be 0..1" -- "$CYL" detect "$T/s.cylraw" --table $TABLE --calib $CALIB --side-sigma-free 1.5 --out "$T/x.jsonl"
 finish
 
 start stdout_stream

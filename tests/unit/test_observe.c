@@ -390,6 +390,53 @@ static void test_side_colour(void **st)
     p.partial_side_max = 0.5;
     assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
     assert_true(obs[0].flags & CYL_OBS_PARTIAL);
+    {
+        /* as a sigma of the view's u bias: (C (|s| - D) w)^2 = (0.25 x 0.9 x 40)^2 = 81 px^2 added
+         * to var_u alone; the covariances grow by 81 J_u J_u^T, J_u the Jacobian of (range,
+         * bearing) in u, which is minus jac_calib's column of cx (u enters as u - cx) */
+        cyl_observation o0;
+        int i, j;
+        const int ya = 400, yb = 499;   /* below the horizon: with a range */
+        assert_true(p.side_sigma_rel == CYL_SIDE_SIGMA_REL_DEFAULT && p.side_sigma_free == CYL_SIDE_SIGMA_FREE_DEFAULT);
+        hs_init(&H);
+        hs_rect(&H, 0, x0, ya, x1, yb);
+        yuyv_fill(f, W, x0, x1, ya, yb, 120, 128 - 38, 128 + 52);
+        yuyv_fill(f, W, x0 - 4, x0 - 1, ya, yb, 170, 128 - 23, 128 + 31);
+        p.side_sigma_rel = 0.0;
+        assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+        o0 = obs[0];
+        assert_true(fabs(o0.side_colour_rel - 1.0) < 1e-12);
+        assert_true(o0.w_px == 40.0 && !(o0.flags & (CYL_OBS_INVALID | CYL_OBS_NO_RANGE)));
+        p.side_sigma_rel = 0.25;
+        p.side_sigma_free = 0.1;
+        assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+        assert_true(fabs(obs[0].var_u_px2 - o0.var_u_px2 - 81.0) < 1e-9);
+        assert_true(obs[0].var_v_px2 == o0.var_v_px2 && obs[0].bias_var_u_px2 == o0.bias_var_u_px2);
+        assert_true(obs[0].u_px == o0.u_px && obs[0].range_m == o0.range_m && obs[0].flags == o0.flags);
+        for (i = 0; i < 2; i++)
+            for (j = 0; j < 2; j++) {
+                const double d = 81.0 * o0.jac_calib[i][2] * o0.jac_calib[j][2];
+                assert_true(d != 0.0);
+                assert_true(fabs(obs[0].cov_rb[i][j] - o0.cov_rb[i][j] - d) < 1e-9 * fabs(d));
+                assert_true(fabs(obs[0].cov_rb_frame[i][j] - o0.cov_rb_frame[i][j] - d) < 1e-9 * fabs(d));
+            }
+        /* |s| up to the free share adds nothing */
+        p.side_sigma_free = 1.0;
+        assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
+        assert_true(obs[0].var_u_px2 == o0.var_u_px2 && obs[0].cov_rb[0][0] == o0.cov_rb[0][0]);
+        /* out of range refused */
+        p.side_sigma_free = 1.5;
+        assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_ERR_ARG);
+        p.side_sigma_free = 0.1;
+        p.side_sigma_rel = NAN;
+        assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_ERR_ARG);
+        p.side_sigma_rel = -0.5;
+        assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_ERR_ARG);
+        p.side_sigma_rel = 0.0;
+        yuyv_fill(f, W, x0 - 4, x1 + 4, ya, yb, 100, 128, 128);
+        hs_init(&H);
+        hs_rect(&H, 0, x0, y0, x1, y1);
+    }
     /* weaker than half the blob's chroma (0.4 of it): not the blob's colour */
     yuyv_fill(f, W, x0 - 4, x0 - 1, y0, y1, 170, 128 - 15, 128 + 21);
     assert_int_equal(cyl_observe(&H.seg, &cam, &p, NULL, 0, obs, 8, &n), CYL_OK);
