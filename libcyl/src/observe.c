@@ -166,40 +166,43 @@ static void calib_share(cyl_observation *o, const cyl_camera *cam, const cyl_rb_
         }
 }
 
-/* A part missing from the blob's box, or extra, as aspect_rel measures it against the whole
- * landmark's (a side: aspect_rel < 1; the top or bottom: > 1), moves the centroid by half its size
- * if it lies on one side, and which side is not known: `share` of that shift is the sigma of a
- * bias added to the point's variances (var_*, bias_var_*); the covariances are propagated again
- * from them at the same point (cyl_rb_compute, calib_share). */
-static void add_missing_part(cyl_observation *o, const cyl_camera *cam, const cyl_observe_params *p, double share)
+/* After a located observation's point variances (var_u_px2, var_v_px2) have grown: its
+ * covariances (cov_rb, cov_xy, and jac_calib with cov_rb_frame) propagated again from them at the
+ * same point; the point, range and flags stay. */
+static void propagate_again(cyl_observation *o, const cyl_camera *cam, const cyl_observe_params *p)
 {
-    const double su = share * o->w_px * fmax(1.0 / o->aspect_rel - 1.0, 0.0) / 2.0;
-    const double sv = share * o->h_px * fmax(1.0 - 1.0 / o->aspect_rel, 0.0) / 2.0;
     cyl_rb_result rb;
-    o->var_u_px2 += su * su;
-    o->var_v_px2 += sv * sv;
-    o->bias_var_u_px2 += su * su;
-    o->bias_var_v_px2 += sv * sv;
     if (cyl_rb_compute(cam, p->model, o->u_px, o->v_px, o->var_u_px2, o->var_v_px2, 0.0, &rb) != CYL_OK) return;
     memcpy(o->cov_rb, rb.cov_rb, sizeof o->cov_rb);
     memcpy(o->cov_xy, rb.cov_xy, sizeof o->cov_xy);
     calib_share(o, cam, &rb);
 }
 
+/* A part missing from the blob's box, or extra, as aspect_rel measures it against the whole
+ * landmark's (a side: aspect_rel < 1; the top or bottom: > 1), moves the centroid by half its size
+ * if it lies on one side, and which side is not known: `share` of that shift is the sigma of a
+ * bias added to the point's variances (var_*, bias_var_*), then propagated (propagate_again). */
+static void add_missing_part(cyl_observation *o, const cyl_camera *cam, const cyl_observe_params *p, double share)
+{
+    const double su = share * o->w_px * fmax(1.0 / o->aspect_rel - 1.0, 0.0) / 2.0;
+    const double sv = share * o->h_px * fmax(1.0 - 1.0 / o->aspect_rel, 0.0) / 2.0;
+    o->var_u_px2 += su * su;
+    o->var_v_px2 += sv * sv;
+    o->bias_var_u_px2 += su * su;
+    o->bias_var_v_px2 += sv * sv;
+    propagate_again(o, cam, p);
+}
+
 #if CYL_CONFIG_SUBPIXEL   /* side_colour_rel reads the image around the blob's edges, as sub-pixel edges do */
 /* The landmark's colour beyond one side of the box (side_colour_rel) as a sigma of the view's u
- * bias, added to var_u_px2 alone (it changes from view to view, unlike bias_var); the covariances
- * are propagated again at the same point. Only observations with a range (locate() succeeded). */
+ * bias, added to var_u_px2 alone (it changes from view to view, unlike bias_var), then propagated
+ * (propagate_again). Only observations with a range (locate() succeeded). */
 static void add_side_sigma(cyl_observation *o, const cyl_camera *cam, const cyl_observe_params *p)
 {
     const double su = p->side_sigma_rel * fmax(fabs(o->side_colour_rel) - p->side_sigma_free, 0.0) * o->w_px;
-    cyl_rb_result rb;
     if (!(su > 0.0) || (o->flags & (CYL_OBS_INVALID | CYL_OBS_NO_RANGE))) return;
     o->var_u_px2 += su * su;
-    if (cyl_rb_compute(cam, p->model, o->u_px, o->v_px, o->var_u_px2, o->var_v_px2, 0.0, &rb) != CYL_OK) return;
-    memcpy(o->cov_rb, rb.cov_rb, sizeof o->cov_rb);
-    memcpy(o->cov_xy, rb.cov_xy, sizeof o->cov_xy);
-    calib_share(o, cam, &rb);
+    propagate_again(o, cam, p);
 }
 
 /* The share of one strip's pixels whose chroma (U - 128, V - 128) points within acos(0.9) of the
